@@ -1,0 +1,11 @@
+//! acm-workbench: the Anatomical Constraint Method for IMU joint angles.
+//!
+//! The numerical core (`rotation`, `model`, `limits`, `trial`, `acm`, `metrics`,
+//! `sidecar`, `simulate`) knows nothing of the terminal; `ui` and the `acmw`
+//! binary are thin layers over it.
+
+pub mod limits;
+pub mod model;
+pub mod rotation;
+pub mod save;
+pub mod trial;

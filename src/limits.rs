@@ -1,0 +1,621 @@
+//! Joint limit tables (METHOD.md section 5) and correction settings.
+//!
+//! A limit table is a CSV file, one row per joint and axis:
+//!
+//! ```text
+//! joint,axis,movement,lower_deg,upper_deg,centroid_deg,lambda2
+//! knee,Y,flexion/extension,0,130,,0
+//! ```
+//!
+//! `joint` is a joint kind of the model (`knee` covers `l_knee` and `r_knee`) or a
+//! single joint's name (`l_knee`), which then overrides the kind's rows. Angles are
+//! Z-Y-X Euler angles of the joint rotation in degrees. `centroid_deg` is empty when
+//! the joint has no centroid; `lambda2` weighs the centroid term and is the same on
+//! the joint's three rows. The global settings (`lambda1`, window and hop) live in
+//! `joint_limits/settings.toml` (see [`Settings`]).
+
+use crate::model::Model;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The tables shipped with the program: (file name, CSV text).
+pub const BUILTIN_TABLES: &[(&str, &str)] = &[
+    (
+        "table_3_2.csv",
+        include_str!("../joint_limits/table_3_2.csv"),
+    ),
+    (
+        "table_3_1.csv",
+        include_str!("../joint_limits/table_3_1.csv"),
+    ),
+];
+
+/// The settings shipped with the program.
+pub const BUILTIN_SETTINGS: &str = include_str!("../joint_limits/settings.toml");
+
+/// The CSV header every limit table starts with.
+pub const HEADER: [&str; 7] = [
+    "joint",
+    "axis",
+    "movement",
+    "lower_deg",
+    "upper_deg",
+    "centroid_deg",
+    "lambda2",
+];
+
+/// One row: the limits of one axis of one joint (kind), degrees.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LimitRow {
+    pub joint: String,
+    /// 0 = X, 1 = Y, 2 = Z.
+    pub axis: usize,
+    pub movement: String,
+    pub lower_deg: f64,
+    pub upper_deg: f64,
+    pub centroid_deg: Option<f64>,
+    pub lambda2: f64,
+}
+
+/// Limits, centroid and weight of one joint, ready for the cost function.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointLimits {
+    /// `[lower, upper]` per axis X, Y, Z, degrees.
+    pub range_deg: [[f64; 2]; 3],
+    /// Centroid Z-Y-X angles, degrees, when the table sets one.
+    pub centroid_deg: Option<[f64; 3]>,
+    /// Weight of the centroid term (METHOD.md section 3).
+    pub lambda2: f64,
+}
+
+/// A whole limit table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LimitTable {
+    /// Comment lines (starting `#`) above the header, kept when saving.
+    #[serde(default)]
+    pub preamble: Vec<String>,
+    pub rows: Vec<LimitRow>,
+}
+
+/// A limit table or settings problem, located in its file.
+#[derive(Debug, Clone, thiserror::Error, PartialEq)]
+#[error("{file}:{line}:{column}: {message}")]
+pub struct LimitsError {
+    pub file: String,
+    /// 1-based line; 0 when the problem is the file as a whole.
+    pub line: u64,
+    /// 1-based column (field index); 0 when the whole row or file is meant.
+    pub column: usize,
+    pub message: String,
+}
+
+/// Settings of a correction that are not per joint.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    /// Weight of the correction's rotation angle in the cost (per degree).
+    pub lambda1: f64,
+    /// Window length, seconds (METHOD.md section 4).
+    pub window_s: f64,
+    /// Hop between window starts, seconds.
+    pub hop_s: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            lambda1: 0.05,
+            window_s: 60.0,
+            hop_s: 30.0,
+        }
+    }
+}
+
+/// `joint_limits/settings.toml`: the settings plus the name of the default table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SettingsFile {
+    /// File name of the default limit table in the same folder.
+    pub table: String,
+    pub lambda1: f64,
+    pub window_s: f64,
+    pub hop_s: f64,
+}
+
+impl SettingsFile {
+    /// Parses and validates the settings TOML; `origin` names the file in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<SettingsFile, LimitsError> {
+        let s: SettingsFile = toml::from_str(text).map_err(|e| {
+            let (line, column) = e
+                .span()
+                .map(|sp| line_col(text, sp.start))
+                .unwrap_or((0, 0));
+            LimitsError {
+                file: origin.into(),
+                line,
+                column,
+                message: e.message().to_string(),
+            }
+        })?;
+        s.settings().validate(origin)?;
+        Ok(s)
+    }
+
+    /// The correction settings it holds.
+    pub fn settings(&self) -> Settings {
+        Settings {
+            lambda1: self.lambda1,
+            window_s: self.window_s,
+            hop_s: self.hop_s,
+        }
+    }
+
+    /// TOML text for saving.
+    pub fn to_toml(&self) -> String {
+        format!(
+            "# Correction settings (METHOD.md sections 3-4); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n",
+            self.table, self.lambda1, self.window_s, self.hop_s
+        )
+    }
+}
+
+fn line_col(text: &str, offset: usize) -> (u64, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() as u64 + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+impl Settings {
+    /// Checks the values are usable: finite, lambda1 >= 0, 0 < hop <= window.
+    pub fn validate(&self, origin: &str) -> Result<(), LimitsError> {
+        let err = |message: String| LimitsError {
+            file: origin.into(),
+            line: 0,
+            column: 0,
+            message,
+        };
+        if !(self.lambda1.is_finite() && self.lambda1 >= 0.0) {
+            return Err(err(format!(
+                "lambda1 must be a finite number >= 0, found {}",
+                self.lambda1
+            )));
+        }
+        if !(self.window_s.is_finite() && self.window_s > 0.0) {
+            return Err(err(format!(
+                "window_s must be a positive number of seconds, found {}",
+                self.window_s
+            )));
+        }
+        if !(self.hop_s.is_finite() && self.hop_s > 0.0 && self.hop_s <= self.window_s) {
+            return Err(err(format!(
+                "hop_s must be positive and at most window_s ({}), found {}",
+                self.window_s, self.hop_s
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Parses an axis name `X`, `Y` or `Z` (case-insensitive) into 0, 1, 2.
+pub fn parse_axis(s: &str) -> Option<usize> {
+    match s.trim().to_ascii_uppercase().as_str() {
+        "X" => Some(0),
+        "Y" => Some(1),
+        "Z" => Some(2),
+        _ => None,
+    }
+}
+
+/// The name of axis 0, 1, 2.
+pub fn axis_name(axis: usize) -> &'static str {
+    ["X", "Y", "Z"][axis.min(2)]
+}
+
+impl LimitTable {
+    /// The default table (Table 3-2, "adjusted") as shipped.
+    pub fn default_table() -> LimitTable {
+        LimitTable::parse(BUILTIN_TABLES[0].1, "table_3_2.csv").expect("built-in table is valid")
+    }
+
+    /// Reads and parses a limit table file.
+    pub fn load(path: &Path) -> Result<LimitTable, LimitsError> {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| LimitsError {
+            file: origin.clone(),
+            line: 0,
+            column: 0,
+            message: format!("cannot read: {e}"),
+        })?;
+        LimitTable::parse(&text, &origin)
+    }
+
+    /// Parses CSV text (see the module docs); `origin` names the file in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<LimitTable, LimitsError> {
+        let err = |line: u64, column: usize, message: String| LimitsError {
+            file: origin.into(),
+            line,
+            column,
+            message,
+        };
+        let mut rdr = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .comment(Some(b'#'))
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let header = rdr
+            .headers()
+            .map_err(|e| err(1, 0, format!("cannot read the header: {e}")))?
+            .clone();
+        let found: Vec<&str> = header.iter().collect();
+        if found != HEADER {
+            return Err(err(
+                1,
+                0,
+                format!(
+                    "expected the header `{}`, found `{}`",
+                    HEADER.join(","),
+                    found.join(",")
+                ),
+            ));
+        }
+        let preamble = text
+            .lines()
+            .take_while(|l| l.trim_start().starts_with('#'))
+            .map(str::to_string)
+            .collect();
+        let mut rows = Vec::new();
+        let mut lines = Vec::new();
+        for rec in rdr.records() {
+            let rec = rec.map_err(|e| {
+                let line = e.position().map_or(0, |p| p.line());
+                err(line, 0, format!("expected 7 fields per row: {e}"))
+            })?;
+            let line = rec.position().map_or(0, |p| p.line());
+            rows.push(parse_row(&rec, line, &err)?);
+            lines.push(line);
+        }
+        let table = LimitTable { preamble, rows };
+        table.check_consistency(origin, &lines)?;
+        Ok(table)
+    }
+
+    fn check_consistency(&self, origin: &str, lines: &[u64]) -> Result<(), LimitsError> {
+        let mut seen: BTreeMap<(&str, usize), usize> = BTreeMap::new();
+        for (i, r) in self.rows.iter().enumerate() {
+            if let Some(prev) = seen.insert((r.joint.as_str(), r.axis), i) {
+                return Err(LimitsError {
+                    file: origin.into(),
+                    line: lines[i],
+                    column: 2,
+                    message: format!(
+                        "joint '{}' axis {} appears twice (first on line {})",
+                        r.joint,
+                        axis_name(r.axis),
+                        lines[prev]
+                    ),
+                });
+            }
+        }
+        for (i, r) in self.rows.iter().enumerate() {
+            let siblings: Vec<&LimitRow> =
+                self.rows.iter().filter(|s| s.joint == r.joint).collect();
+            if siblings.iter().any(|s| s.lambda2 != r.lambda2) {
+                return Err(LimitsError {
+                    file: origin.into(),
+                    line: lines[i],
+                    column: 7,
+                    message: format!(
+                        "lambda2 of joint '{}' differs between its rows; expected one value per joint",
+                        r.joint
+                    ),
+                });
+            }
+            if siblings.len() == 3
+                && siblings.iter().any(|s| s.centroid_deg.is_some())
+                && siblings.iter().any(|s| s.centroid_deg.is_none())
+            {
+                return Err(LimitsError {
+                    file: origin.into(),
+                    line: lines[i],
+                    column: 6,
+                    message: format!(
+                        "joint '{}' has a centroid on some axes only; expected all three or none",
+                        r.joint
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that every joint of `model` has all three axes.
+    pub fn check_covers(&self, model: &Model, origin: &str) -> Result<(), LimitsError> {
+        for j in &model.joints {
+            for axis in 0..3 {
+                if self.row(&j.name, &j.kind, axis).is_none() {
+                    return Err(LimitsError {
+                        file: origin.into(),
+                        line: 0,
+                        column: 0,
+                        message: format!(
+                            "no row for joint '{}' (kind '{}') axis {} of model '{}'",
+                            j.name,
+                            j.kind,
+                            axis_name(axis),
+                            model.name
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The row for a joint's axis: the joint's own row if present, else its kind's.
+    pub fn row(&self, joint: &str, kind: &str, axis: usize) -> Option<&LimitRow> {
+        let find = |name: &str| self.rows.iter().find(|r| r.joint == name && r.axis == axis);
+        find(joint).or_else(|| find(kind))
+    }
+
+    /// The limits of one joint; `with_centroid = false` sets lambda2 to 0.
+    pub fn joint_limits(
+        &self,
+        joint: &str,
+        kind: &str,
+        with_centroid: bool,
+    ) -> Option<JointLimits> {
+        let rows = [
+            self.row(joint, kind, 0)?,
+            self.row(joint, kind, 1)?,
+            self.row(joint, kind, 2)?,
+        ];
+        let centroid = match (
+            rows[0].centroid_deg,
+            rows[1].centroid_deg,
+            rows[2].centroid_deg,
+        ) {
+            (Some(x), Some(y), Some(z)) => Some([x, y, z]),
+            _ => None,
+        };
+        let lambda2 = if with_centroid && centroid.is_some() {
+            rows[0].lambda2
+        } else {
+            0.0
+        };
+        Some(JointLimits {
+            range_deg: rows.map(|r| [r.lower_deg, r.upper_deg]),
+            centroid_deg: centroid,
+            lambda2,
+        })
+    }
+
+    /// The table as CSV text, comments first, as saved.
+    pub fn to_csv(&self) -> String {
+        let mut out = String::new();
+        for c in &self.preamble {
+            out.push_str(c);
+            out.push('\n');
+        }
+        out.push_str(&self.rows_csv());
+        out
+    }
+
+    /// Header and rows only, in canonical form: what [`LimitTable::hash`] covers.
+    pub fn rows_csv(&self) -> String {
+        let mut out = HEADER.join(",");
+        out.push('\n');
+        for r in &self.rows {
+            let movement = if r.movement.contains([',', '"']) {
+                format!("\"{}\"", r.movement.replace('"', "\"\""))
+            } else {
+                r.movement.clone()
+            };
+            let _ = writeln!(
+                out,
+                "{},{},{},{},{},{},{}",
+                r.joint,
+                axis_name(r.axis),
+                movement,
+                r.lower_deg,
+                r.upper_deg,
+                r.centroid_deg.map(|c| c.to_string()).unwrap_or_default(),
+                r.lambda2
+            );
+        }
+        out
+    }
+
+    /// SHA-256 of [`LimitTable::rows_csv`], hex: identifies the table's content.
+    pub fn hash(&self) -> String {
+        let digest = Sha256::digest(self.rows_csv().as_bytes());
+        digest.iter().map(|b| format!("{b:02x}")).collect()
+    }
+}
+
+fn parse_row(
+    rec: &csv::StringRecord,
+    line: u64,
+    err: &dyn Fn(u64, usize, String) -> LimitsError,
+) -> Result<LimitRow, LimitsError> {
+    if rec.len() != HEADER.len() {
+        return Err(err(
+            line,
+            0,
+            format!("expected {} fields, found {}", HEADER.len(), rec.len()),
+        ));
+    }
+    let joint = rec[0].to_string();
+    if joint.is_empty() {
+        return Err(err(line, 1, "expected a joint name, found nothing".into()));
+    }
+    let axis = parse_axis(&rec[1])
+        .ok_or_else(|| err(line, 2, format!("expected X, Y or Z, found '{}'", &rec[1])))?;
+    let angle = |col: usize| -> Result<f64, LimitsError> {
+        let s = &rec[col];
+        let v: f64 = s.parse().map_err(|_| {
+            err(
+                line,
+                col + 1,
+                format!("expected {} in degrees, found '{s}'", HEADER[col]),
+            )
+        })?;
+        if !v.is_finite() || !(-180.0..=180.0).contains(&v) {
+            return Err(err(
+                line,
+                col + 1,
+                format!(
+                    "expected {} within -180..180 degrees, found {s}",
+                    HEADER[col]
+                ),
+            ));
+        }
+        Ok(v)
+    };
+    let lower_deg = angle(3)?;
+    let upper_deg = angle(4)?;
+    if lower_deg >= upper_deg {
+        return Err(err(
+            line,
+            5,
+            format!("expected upper_deg > lower_deg, found {upper_deg} <= {lower_deg}"),
+        ));
+    }
+    let centroid_deg = if rec[5].is_empty() {
+        None
+    } else {
+        Some(angle(5)?)
+    };
+    let lambda2: f64 = rec[6].parse().map_err(|_| {
+        err(
+            line,
+            7,
+            format!("expected lambda2 as a number >= 0, found '{}'", &rec[6]),
+        )
+    })?;
+    if !lambda2.is_finite() || lambda2 < 0.0 {
+        return Err(err(
+            line,
+            7,
+            format!("expected lambda2 as a finite number >= 0, found {lambda2}"),
+        ));
+    }
+    Ok(LimitRow {
+        joint,
+        axis,
+        movement: rec[2].to_string(),
+        lower_deg,
+        upper_deg,
+        centroid_deg,
+        lambda2,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shipped_tables_match_method_section_5() {
+        let t = LimitTable::default_table();
+        let m = Model::infant13();
+        t.check_covers(&m, "t").unwrap();
+        let sh = t.joint_limits("l_shoulder", "shoulder", true).unwrap();
+        assert_eq!(sh.range_deg, [[-10.0, 100.0], [-40.0, 60.0], [-70.0, 70.0]]);
+        assert_eq!(sh.centroid_deg, Some([47.0, -1.0, -31.0]));
+        assert_eq!(sh.lambda2, 30.0);
+        let knee = t.joint_limits("r_knee", "knee", true).unwrap();
+        assert_eq!(knee.range_deg, [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]]);
+        assert_eq!((knee.centroid_deg, knee.lambda2), (None, 0.0));
+        let no_c = t.joint_limits("l_hip", "hip", false).unwrap();
+        assert_eq!(no_c.lambda2, 0.0);
+        let t1 = LimitTable::parse(BUILTIN_TABLES[1].1, "table_3_1.csv").unwrap();
+        let sh1 = t1.joint_limits("l_shoulder", "shoulder", true).unwrap();
+        assert_eq!(
+            sh1.range_deg,
+            [[-45.0, 135.0], [-60.0, 60.0], [-90.0, 90.0]]
+        );
+        let back1 = t1.joint_limits("back", "back", true).unwrap();
+        assert_eq!(back1.range_deg[1], [-30.0, 10.0]);
+        let s = SettingsFile::parse(BUILTIN_SETTINGS, "settings.toml").unwrap();
+        assert_eq!(s.settings(), Settings::default());
+        assert_eq!(s.table, "table_3_2.csv");
+    }
+
+    #[test]
+    fn csv_round_trip_and_hash() {
+        let t = LimitTable::default_table();
+        let again = LimitTable::parse(&t.to_csv(), "x").unwrap();
+        assert_eq!(t, again);
+        assert_eq!(t.hash(), again.hash());
+        let mut changed = t.clone();
+        changed.rows[0].upper_deg += 1.0;
+        assert_ne!(t.hash(), changed.hash());
+    }
+
+    #[test]
+    fn joint_row_overrides_kind() {
+        let mut t = LimitTable::default_table();
+        let mut r = t.row("knee", "knee", 1).unwrap().clone();
+        r.joint = "l_knee".into();
+        r.upper_deg = 100.0;
+        t.rows.push(r);
+        assert_eq!(
+            t.joint_limits("l_knee", "knee", true).unwrap().range_deg[1][1],
+            100.0
+        );
+        assert_eq!(
+            t.joint_limits("r_knee", "knee", true).unwrap().range_deg[1][1],
+            130.0
+        );
+    }
+
+    fn parse_err(body: &str) -> LimitsError {
+        let text = format!("{}\n{body}", HEADER.join(","));
+        LimitTable::parse(&text, "bad.csv").unwrap_err()
+    }
+
+    #[test]
+    fn errors_name_file_line_and_column() {
+        let e = parse_err("knee,Y,flexion,0,130,,0\nknee,W,x,0,1,,0\n");
+        assert_eq!((e.line, e.column), (3, 2), "{e}");
+        let e = parse_err("knee,Y,flexion,abc,130,,0\n");
+        assert_eq!((e.line, e.column), (2, 4));
+        assert!(e.to_string().starts_with("bad.csv:2:4:"), "{e}");
+        let e = parse_err("knee,Y,flexion,30,10,,0\n");
+        assert!(e.message.contains("upper_deg > lower_deg"), "{e}");
+        let e = parse_err("knee,Y,flexion,0,200,,0\n");
+        assert_eq!(e.column, 5);
+        let e = parse_err("knee,Y,flexion,0,NaN,,0\n");
+        assert_eq!(e.column, 5);
+        let e = parse_err("knee,Y,flexion,0,100,,-1\n");
+        assert_eq!(e.column, 7);
+        let e = parse_err("knee,Y,flexion,0,100\n");
+        assert_eq!(e.line, 2, "{e}");
+        let e = parse_err("knee,Y,f,0,100,,0\nknee,Y,f,0,100,,0\n");
+        assert!(e.message.contains("twice"), "{e}");
+        let e = LimitTable::parse("a,b\n", "h.csv").unwrap_err();
+        assert_eq!(e.line, 1);
+        let t = LimitTable::parse(&format!("{}\nknee,Y,f,0,1,,0\n", HEADER.join(",")), "s.csv")
+            .unwrap();
+        let e = t.check_covers(&Model::infant13(), "s.csv").unwrap_err();
+        assert!(e.message.contains("no row for joint 'back'"), "{e}");
+    }
+
+    #[test]
+    fn settings_errors_are_located() {
+        let e = SettingsFile::parse(
+            "table = \"t.csv\"\nlambda1 = \"x\"\nwindow_s = 60.0\nhop_s = 30.0\n",
+            "s.toml",
+        )
+        .unwrap_err();
+        assert_eq!(e.line, 2, "{e}");
+        let e = SettingsFile::parse(
+            "table = \"t.csv\"\nlambda1 = 0.05\nwindow_s = 60.0\nhop_s = 90.0\n",
+            "s.toml",
+        )
+        .unwrap_err();
+        assert!(e.message.contains("hop_s"), "{e}");
+    }
+}

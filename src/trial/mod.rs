@@ -1,0 +1,128 @@
+//! Recorded trials: IMU orientations over time, and their file formats.
+//!
+//! A [`Trial`] holds, per IMU, the orientation `G_R_imu` (sensor frame to global
+//! frame G) at each sample time (seconds). Readers and writers for the supported
+//! formats live in the submodules; [`read_trial`] and [`write_trial`] pick by
+//! file name.
+
+use crate::rotation::Quat;
+use serde::{Deserialize, Serialize};
+
+mod error;
+mod io;
+
+pub use error::TrialError;
+pub use io::*;
+
+/// Orientations of one IMU over the trial's samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImuSeries {
+    /// Canonical IMU name (after the model's aliases).
+    pub name: String,
+    /// `G_R_imu` per sample, unit quaternions.
+    pub orientation: Vec<Quat>,
+}
+
+/// A recorded (or corrected) trial.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trial {
+    /// Display name (the file name without folder).
+    pub name: String,
+    /// Sample times in seconds, strictly increasing.
+    pub time_s: Vec<f64>,
+    /// IMUs in file order, each with one orientation per sample.
+    pub imus: Vec<ImuSeries>,
+    /// Things the reader noticed that are not errors (renormalised quaternions, ...).
+    pub warnings: Vec<String>,
+}
+
+/// The file formats a trial can be read from and written to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum TrialFormat {
+    /// `time,<imu>_qw,<imu>_qx,<imu>_qy,<imu>_qz,...` (canonical CSV).
+    QuatCsv,
+    /// `time,<imu>_roll,<imu>_pitch,<imu>_yaw,...`, degrees, Z-Y-X (CHR-UM6).
+    EulerCsv,
+    /// OpenSim orientation `.sto` (OpenSense), tab-separated `w,x,y,z` cells.
+    Sto,
+}
+
+impl Trial {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.time_s.len()
+    }
+
+    /// True when the trial has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.time_s.is_empty()
+    }
+
+    /// The series of the IMU with this canonical name.
+    pub fn imu(&self, name: &str) -> Option<&ImuSeries> {
+        self.imus.iter().find(|s| s.name == name)
+    }
+
+    /// Mutable access to the series of the IMU with this canonical name.
+    pub fn imu_mut(&mut self, name: &str) -> Option<&mut ImuSeries> {
+        self.imus.iter_mut().find(|s| s.name == name)
+    }
+
+    /// Median interval between samples, seconds (0 for fewer than two samples).
+    pub fn median_dt(&self) -> f64 {
+        median_dt(&self.time_s)
+    }
+
+    /// Trial length `T = n * dt` with dt the median sample interval (METHOD.md section 4).
+    pub fn duration_s(&self) -> f64 {
+        self.len() as f64 * self.median_dt()
+    }
+
+    /// Nominal sampling rate in Hz (1 / median interval; 0 when unknown).
+    pub fn rate_hz(&self) -> f64 {
+        let dt = self.median_dt();
+        if dt > 0.0 {
+            1.0 / dt
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Median of the differences of consecutive times (0 for fewer than two).
+pub fn median_dt(time_s: &[f64]) -> f64 {
+    if time_s.len() < 2 {
+        return 0.0;
+    }
+    let mut d: Vec<f64> = time_s.windows(2).map(|w| w[1] - w[0]).collect();
+    let mid = d.len() / 2;
+    let (_, m, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
+    let upper = *m;
+    if d.len() % 2 == 1 {
+        upper
+    } else {
+        let lower = d[..mid].iter().copied().fold(f64::MIN, f64::max);
+        0.5 * (lower + upper)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_interval_and_duration() {
+        assert_eq!(median_dt(&[0.0]), 0.0);
+        assert_eq!(median_dt(&[0.0, 0.02, 0.04, 0.1]), 0.02);
+        assert!((median_dt(&[0.0, 1.0, 3.0, 6.0, 10.0]) - 2.5).abs() < 1e-12);
+        let t = Trial {
+            name: "x".into(),
+            time_s: (0..3000).map(|i| i as f64 * 0.02).collect(),
+            imus: vec![],
+            warnings: vec![],
+        };
+        assert!((t.duration_s() - 60.0).abs() < 1e-9);
+        assert!((t.rate_hz() - 50.0).abs() < 1e-9);
+    }
+}
