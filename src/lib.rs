@@ -4,8 +4,12 @@
 //! `sidecar`, `simulate`) knows nothing of the terminal; `ui` and the `acmw`
 //! binary are thin layers over it.
 
+pub mod acm;
 pub mod limits;
+pub mod metrics;
 pub mod model;
+pub mod report;
 pub mod rotation;
 pub mod save;
+pub mod sidecar;
 pub mod trial;

@@ -8,6 +8,9 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
+mod common;
+mod correct;
+mod report;
 mod simulate;
 
 /// Exit code: success.
@@ -30,6 +33,10 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Correct a trial and write the corrected trial plus a sidecar JSON.
+    Correct(correct::CorrectArgs),
+    /// Print the figures (METHOD.md section 6) before and after each variant.
+    Report(report::ReportArgs),
     /// Simulate a trial with known misalignment and drift, and write its truth beside it.
     Simulate(simulate::SimulateArgs),
 }
@@ -37,6 +44,8 @@ pub enum Command {
 /// Runs the parsed command line; returns the process exit code.
 pub fn run(cli: Cli) -> i32 {
     let result = match cli.command {
+        Some(Command::Correct(a)) => correct::run(a),
+        Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
         None => {
             use clap::CommandFactory;
@@ -48,7 +57,20 @@ pub fn run(cli: Cli) -> i32 {
         Ok(code) => code,
         Err(e) => {
             eprintln!("acmw: {e:#}");
-            EXIT_FAILURE
+            if is_bad_input(&e) {
+                EXIT_BAD_INPUT
+            } else {
+                EXIT_FAILURE
+            }
         }
     }
+}
+
+/// Whether an error comes from malformed input data (exit code 3).
+fn is_bad_input(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.is::<acm_workbench::trial::TrialError>()
+            || c.is::<acm_workbench::limits::LimitsError>()
+            || c.is::<acm_workbench::model::ModelError>()
+    })
 }

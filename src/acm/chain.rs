@@ -1,0 +1,307 @@
+//! Correcting a whole trial down the model's chain (METHOD.md sections 2-4).
+//!
+//! Joints are taken in the model's correction order. Joints at the same depth of
+//! the chain never depend on each other and run in parallel, as do the windows
+//! of one joint; every window's result depends only on its inputs, so the output
+//! is bit-identical for any thread count.
+
+use super::cost::WindowCost;
+use super::minimise::{minimise, MinimiseOptions, Solution};
+use super::window::{correction_series, layout, whole_trial, Window};
+use super::{Cancelled, Correction, JointResult, RunControl, SkippedJoint, Variant, WindowSolution};
+use crate::limits::{JointLimits, LimitTable, Settings};
+use crate::model::{Joint, Model};
+use crate::rotation::{angle_deg, canonical, quat_from_wxyz, wxyz, Quat};
+use crate::trial::Trial;
+use rayon::prelude::*;
+use std::collections::{BTreeSet, HashMap};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The solved correction of one joint: per-window solutions and the per-sample series.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointSolution {
+    pub windows: Vec<WindowSolution>,
+    /// `C(t)` per sample (sensor frame of the distal IMU).
+    pub series: Vec<Quat>,
+}
+
+/// Corrects every joint of `model` present in `trial` with `variant`.
+pub fn correct_trial(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    settings: &Settings,
+    variant: Variant,
+    control: &RunControl,
+) -> Result<Correction, Cancelled> {
+    run(trial, model, limits, settings, variant, None, control)
+}
+
+/// Re-corrects the named joints and everything below them, reusing `previous`
+/// for the rest (after a limit edit, say). `previous` must come from the same
+/// trial, model and variant.
+pub fn recorrect(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    settings: &Settings,
+    previous: &Correction,
+    joints: &[&str],
+    control: &RunControl,
+) -> Result<Correction, Cancelled> {
+    let mut redo = BTreeSet::new();
+    for (k, j) in model.joints.iter().enumerate() {
+        if joints.contains(&j.name.as_str()) {
+            redo.insert(k);
+            redo.extend(model.descendants(k));
+        }
+    }
+    run(
+        trial,
+        model,
+        limits,
+        settings,
+        previous.variant,
+        Some((previous, &redo)),
+        control,
+    )
+}
+
+/// Why a joint cannot be corrected in this trial, if it cannot.
+fn skip_reason(trial: &Trial, joint: &Joint, limits: &LimitTable) -> Option<String> {
+    for imu in [&joint.proximal, &joint.distal] {
+        if trial.imu(imu).is_none() {
+            return Some(format!("IMU '{imu}' is not in the trial"));
+        }
+    }
+    if limits.joint_limits(&joint.name, &joint.kind, false).is_none() {
+        return Some(format!("the limit table has no rows for '{}'", joint.kind));
+    }
+    None
+}
+
+fn run(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    settings: &Settings,
+    variant: Variant,
+    reuse: Option<(&Correction, &BTreeSet<usize>)>,
+    control: &RunControl,
+) -> Result<Correction, Cancelled> {
+    let windows = if variant.windowed() {
+        layout(&trial.time_s, settings.window_s, settings.hop_s)
+    } else {
+        whole_trial(&trial.time_s)
+    };
+    let mut corrected = trial.clone();
+    let mut skipped = Vec::new();
+    let mut todo: Vec<(usize, JointLimits)> = Vec::new();
+    for (k, joint) in model.joints.iter().enumerate() {
+        match skip_reason(trial, joint, limits) {
+            Some(reason) => skipped.push(SkippedJoint {
+                joint: joint.name.clone(),
+                reason,
+            }),
+            None => {
+                let lim = limits
+                    .joint_limits(&joint.name, &joint.kind, variant.centroid())
+                    .expect("checked by skip_reason");
+                todo.push((k, lim));
+            }
+        }
+    }
+    let solve_count = todo
+        .iter()
+        .filter(|(k, _)| reuse.is_none_or(|(_, redo)| redo.contains(k)))
+        .count();
+    let total = solve_count * windows.len();
+    let done = AtomicUsize::new(0);
+    let depths = model.joint_depths();
+    let mut results: HashMap<usize, JointResult> = HashMap::new();
+    let max_depth = depths.iter().copied().max().unwrap_or(0);
+    for depth in 0..=max_depth {
+        let level: Vec<&(usize, JointLimits)> =
+            todo.iter().filter(|(k, _)| depths[*k] == depth).collect();
+        let solved: Vec<(usize, JointResult, Vec<Quat>)> = level
+            .par_iter()
+            .map(|(k, lim)| {
+                let joint = &model.joints[*k];
+                let parent_corrected = results_has_imu(&results, model, &joint.proximal);
+                if let Some((prev, redo)) = reuse {
+                    if !redo.contains(k) {
+                        if let Some(r) = prev.joint(&joint.name) {
+                            let series = reuse_series(trial, prev, &joint.distal);
+                            return Ok((*k, r.clone(), series));
+                        }
+                    }
+                }
+                let parent = &corrected.imu(&joint.proximal).expect("present").orientation;
+                let child = &trial.imu(&joint.distal).expect("present").orientation;
+                let measured: Vec<Quat> = parent
+                    .iter()
+                    .zip(child)
+                    .map(|(p, c)| p.inverse() * c)
+                    .collect();
+                let progress = || {
+                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    if let Some(p) = control.progress {
+                        p(d, total);
+                    }
+                };
+                let sol = solve_windows(
+                    &trial.time_s,
+                    &measured,
+                    &windows,
+                    lim,
+                    settings.lambda1,
+                    control,
+                    &progress,
+                )?;
+                let result = JointResult {
+                    joint: joint.name.clone(),
+                    proximal: joint.proximal.clone(),
+                    distal: joint.distal.clone(),
+                    lambda2: lim.lambda2,
+                    parent_corrected,
+                    windows: sol.windows,
+                };
+                Ok((*k, result, sol.series))
+            })
+            .collect::<Result<_, Cancelled>>()?;
+        for (k, result, series) in solved {
+            let distal = &model.joints[k].distal;
+            let imu = corrected.imu_mut(distal).expect("present");
+            for (q, c) in imu.orientation.iter_mut().zip(&series) {
+                *q = Quat::new_normalize((*q * c).into_inner());
+            }
+            results.insert(k, result);
+        }
+    }
+    let mut joints: Vec<(usize, JointResult)> = results.into_iter().collect();
+    joints.sort_by_key(|(k, _)| *k);
+    Ok(Correction {
+        variant,
+        settings: *settings,
+        corrected,
+        joints: joints.into_iter().map(|(_, r)| r).collect(),
+        skipped,
+    })
+}
+
+fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &str) -> bool {
+    results
+        .keys()
+        .any(|&k| model.joints[k].distal == imu)
+}
+
+/// The per-sample correction a previous run applied to `imu`: `raw^-1 * corrected`.
+fn reuse_series(trial: &Trial, prev: &Correction, imu: &str) -> Vec<Quat> {
+    let raw = &trial.imu(imu).expect("present").orientation;
+    let cor = &prev.corrected.imu(imu).expect("present").orientation;
+    raw.iter().zip(cor).map(|(r, c)| r.inverse() * c).collect()
+}
+
+/// Solves one joint: the measured joint rotations `Rm_i` (parent' to child), per sample.
+///
+/// `windows` come from [`layout`] or [`whole_trial`]. Returns the per-window
+/// solutions and the slerped per-sample correction.
+pub fn correct_joint(
+    time_s: &[f64],
+    measured: &[Quat],
+    windows: &[Window],
+    limits: &JointLimits,
+    lambda1: f64,
+) -> JointSolution {
+    solve_windows(
+        time_s,
+        measured,
+        windows,
+        limits,
+        lambda1,
+        &RunControl::default(),
+        &|| {},
+    )
+    .expect("no cancel flag")
+}
+
+fn solve_windows(
+    time_s: &[f64],
+    measured: &[Quat],
+    windows: &[Window],
+    limits: &JointLimits,
+    lambda1: f64,
+    control: &RunControl,
+    progress: &(dyn Fn() + Sync),
+) -> Result<JointSolution, Cancelled> {
+    let opts = MinimiseOptions::default();
+    let costs: Vec<WindowCost> = windows
+        .iter()
+        .map(|w| WindowCost::new(&measured[w.first..w.end], limits, lambda1))
+        .collect();
+    // Pass 1: every window from identity, in parallel.
+    let first: Vec<Solution> = costs
+        .par_iter()
+        .map(|cost| {
+            if control.cancelled() {
+                return Err(Cancelled);
+            }
+            let s = minimise(&|c| cost.eval(c), &[Quat::identity()], &opts);
+            progress();
+            Ok(s)
+        })
+        .collect::<Result<_, Cancelled>>()?;
+    // Pass 2: where a neighbour's solution is cheaper here, descend from it.
+    let second: Vec<Solution> = (0..costs.len())
+        .into_par_iter()
+        .map(|k| {
+            let cost = &costs[k];
+            let neighbours = [k.wrapping_sub(1), k + 1]
+                .into_iter()
+                .filter(|&n| n < costs.len())
+                .map(|n| first[n].c)
+                .filter(|c| cost.eval(c) < first[k].cost - 1e-12)
+                .collect::<Vec<_>>();
+            if neighbours.is_empty() {
+                return first[k];
+            }
+            let s = minimise(&|c| cost.eval(c), &neighbours, &opts);
+            if s.cost < first[k].cost {
+                Solution {
+                    evaluations: s.evaluations + first[k].evaluations,
+                    ..s
+                }
+            } else {
+                first[k]
+            }
+        })
+        .collect();
+    let solutions: Vec<WindowSolution> = windows
+        .iter()
+        .zip(&costs)
+        .zip(&second)
+        .map(|((w, cost), s)| {
+            let c = canonical(&s.c);
+            WindowSolution {
+                start_s: w.start_s,
+                end_s: w.end_s,
+                centre_s: w.centre_s,
+                samples: w.len(),
+                correction: wxyz(&c),
+                angle_deg: angle_deg(&c),
+                cost: s.cost,
+                cost_uncorrected: cost.eval(&Quat::identity()),
+                evaluations: s.evaluations,
+            }
+        })
+        .collect();
+    let centres: Vec<f64> = solutions.iter().map(|w| w.centre_s).collect();
+    let qs: Vec<Quat> = solutions
+        .iter()
+        .map(|w| quat_from_wxyz(w.correction))
+        .collect();
+    Ok(JointSolution {
+        series: correction_series(time_s, &centres, &qs),
+        windows: solutions,
+    })
+}

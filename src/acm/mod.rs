@@ -1,0 +1,149 @@
+//! The Anatomical Constraint Method (METHOD.md sections 3-4).
+//!
+//! Per joint, the correction C of the distal IMU keeps the joint's Z-Y-X angles
+//! inside their limits (and, with a centroid, near it) at the least rotation.
+//! Corrections are solved per window and slerped between window centres, joint
+//! by joint down the model's chain, each joint measured against its parent's
+//! corrected orientation: `Rm = (G_R_prox')^T G_R_dist`, `G_R_dist' = G_R_dist C`.
+
+pub mod chain;
+pub mod cost;
+pub mod minimise;
+pub mod window;
+
+pub use chain::{correct_joint, correct_trial, recorrect};
+
+use crate::limits::Settings;
+use crate::trial::Trial;
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The correction variants the engine offers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Variant {
+    /// One correction per joint for the whole trial, no centroid term.
+    Basic,
+    /// Windows + slerp to follow drift, no centroid term (lambda2 = 0).
+    Drift,
+    /// Windows + slerp + the centroid term (lambda2 from the table).
+    DriftCentroid,
+}
+
+impl Variant {
+    /// Every variant, in the order screens and reports list them.
+    pub const ALL: [Variant; 3] = [Variant::Basic, Variant::Drift, Variant::DriftCentroid];
+
+    /// The name used on the command line, in files and on screen.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Basic => "basic",
+            Variant::Drift => "drift",
+            Variant::DriftCentroid => "drift-centroid",
+        }
+    }
+
+    /// Parses a variant name.
+    pub fn from_name(name: &str) -> Option<Variant> {
+        Variant::ALL.into_iter().find(|v| v.name() == name)
+    }
+
+    /// Solves per window (true) or once for the whole trial (false).
+    pub fn windowed(self) -> bool {
+        !matches!(self, Variant::Basic)
+    }
+
+    /// Uses the table's centroid term.
+    pub fn centroid(self) -> bool {
+        matches!(self, Variant::DriftCentroid)
+    }
+}
+
+impl std::fmt::Display for Variant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The solution of one window of one joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WindowSolution {
+    /// Window start and end (exclusive), seconds from the first sample.
+    pub start_s: f64,
+    pub end_s: f64,
+    /// Window centre, seconds from the first sample.
+    pub centre_s: f64,
+    /// Samples inside the window.
+    pub samples: usize,
+    /// The correction C (sensor frame of the distal IMU), `[w, x, y, z]`, w >= 0.
+    pub correction: [f64; 4],
+    /// Rotation angle of C, degrees.
+    pub angle_deg: f64,
+    /// Cost at C.
+    pub cost: f64,
+    /// Cost without correction (C = identity).
+    pub cost_uncorrected: f64,
+    /// Cost evaluations spent.
+    pub evaluations: usize,
+}
+
+/// The correction of one joint's distal IMU.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JointResult {
+    pub joint: String,
+    pub proximal: String,
+    pub distal: String,
+    /// The centroid weight used (0 without centroid term).
+    pub lambda2: f64,
+    /// Whether the parent IMU had been corrected (false when it is the base or
+    /// its own joint was skipped).
+    pub parent_corrected: bool,
+    pub windows: Vec<WindowSolution>,
+}
+
+/// A joint the engine did not correct, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SkippedJoint {
+    pub joint: String,
+    pub reason: String,
+}
+
+/// A whole-trial correction: the corrected trial plus what was done per joint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Correction {
+    pub variant: Variant,
+    pub settings: Settings,
+    /// The trial with every corrected IMU replaced by `G_R_dist * C(t)`.
+    pub corrected: Trial,
+    /// Corrected joints in model order.
+    pub joints: Vec<JointResult>,
+    /// Joints of the model that were not corrected.
+    pub skipped: Vec<SkippedJoint>,
+}
+
+impl Correction {
+    /// The result for a joint.
+    pub fn joint(&self, name: &str) -> Option<&JointResult> {
+        self.joints.iter().find(|j| j.joint == name)
+    }
+}
+
+/// The run was cancelled before it finished.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("correction cancelled")]
+pub struct Cancelled;
+
+/// Progress reporting and cancellation for a long run.
+#[derive(Default, Clone, Copy)]
+pub struct RunControl<'a> {
+    /// Checked before each window; when set, the run stops with [`Cancelled`].
+    pub cancel: Option<&'a AtomicBool>,
+    /// Called with (windows done, windows in all) after each window.
+    pub progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
+}
+
+impl RunControl<'_> {
+    fn cancelled(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+}

@@ -1,0 +1,58 @@
+//! `acmw report`: the METHOD.md section 6 figures before and after each variant.
+
+use super::common::{load_context, EngineArgs, Progress};
+use acm_workbench::acm::{RunControl, Variant};
+use acm_workbench::report::{format_text, ReportInput};
+use acm_workbench::trial::read_trial;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// The trial to report on (.csv, .sto, optionally .gz).
+    pub input: PathBuf,
+    /// Variants to run and compare (repeatable) [default: all].
+    #[arg(long, value_enum)]
+    pub variant: Vec<Variant>,
+    /// Print JSON instead of text tables.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub engine: EngineArgs,
+    /// No progress output.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs `acmw report`.
+pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
+    let ctx = load_context(&args.engine, Some(&args.input))?;
+    let trial = read_trial(&args.input, &ctx.model)?;
+    let variants = if args.variant.is_empty() {
+        Variant::ALL.to_vec()
+    } else {
+        args.variant.clone()
+    };
+    let progress = Progress::new(&trial.name, args.quiet);
+    let report = |d: usize, t: usize| progress.update(d, t);
+    let control = RunControl {
+        cancel: None,
+        progress: Some(&report),
+    };
+    let input = ReportInput {
+        trial: &trial,
+        model: &ctx.model,
+        limits: &ctx.limits,
+        limits_source: &ctx.limits_source,
+        settings: &ctx.settings,
+        truth: None,
+    };
+    let r = input.run(&variants, &control)?;
+    progress.finish();
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        print!("{}", format_text(&r));
+    }
+    Ok(0)
+}

@@ -1,0 +1,191 @@
+//! A trial's figures before and after each correction variant, as a data
+//! structure (for JSON and screens) and as aligned text tables (for terminals).
+
+use crate::acm::{correct_trial, Cancelled, Correction, RunControl, SkippedJoint, Variant};
+use crate::limits::{LimitTable, Settings};
+use crate::metrics::{trial_figures, JointFigures};
+use crate::model::Model;
+use crate::trial::Trial;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+
+/// The figures of one variant.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VariantReport {
+    pub variant: Variant,
+    pub joints: Vec<JointFigures>,
+    pub skipped: Vec<SkippedJoint>,
+}
+
+/// A trial's figures, uncorrected and per variant.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialReport {
+    pub trial: String,
+    pub samples: usize,
+    pub duration_s: f64,
+    pub rate_hz: f64,
+    pub imus: Vec<String>,
+    pub model: String,
+    pub limits_source: String,
+    pub limits_sha256: String,
+    pub settings: Settings,
+    /// Whether a ground truth was compared against.
+    pub truth: bool,
+    pub uncorrected: Vec<JointFigures>,
+    pub variants: Vec<VariantReport>,
+    pub warnings: Vec<String>,
+}
+
+/// Inputs of a report.
+pub struct ReportInput<'a> {
+    pub trial: &'a Trial,
+    pub model: &'a Model,
+    pub limits: &'a LimitTable,
+    pub limits_source: &'a str,
+    pub settings: &'a Settings,
+    /// True segment orientations, when known.
+    pub truth: Option<&'a Trial>,
+}
+
+impl ReportInput<'_> {
+    /// Figures of the uncorrected trial and of already computed corrections.
+    pub fn report(&self, corrections: &[Correction]) -> TrialReport {
+        let t = self.trial;
+        TrialReport {
+            trial: t.name.clone(),
+            samples: t.len(),
+            duration_s: t.duration_s(),
+            rate_hz: t.rate_hz(),
+            imus: t.imus.iter().map(|i| i.name.clone()).collect(),
+            model: self.model.name.clone(),
+            limits_source: self.limits_source.to_string(),
+            limits_sha256: self.limits.hash(),
+            settings: *self.settings,
+            truth: self.truth.is_some(),
+            uncorrected: trial_figures(t, None, self.truth, self.model, self.limits),
+            variants: corrections
+                .iter()
+                .map(|c| VariantReport {
+                    variant: c.variant,
+                    joints: trial_figures(&c.corrected, Some(t), self.truth, self.model, self.limits),
+                    skipped: c.skipped.clone(),
+                })
+                .collect(),
+            warnings: t.warnings.clone(),
+        }
+    }
+
+    /// Runs each variant, then reports.
+    pub fn run(&self, variants: &[Variant], control: &RunControl) -> Result<TrialReport, Cancelled> {
+        let corrections = variants
+            .iter()
+            .map(|&v| correct_trial(self.trial, self.model, self.limits, self.settings, v, control))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(self.report(&corrections))
+    }
+}
+
+fn xyz(v: [f64; 3], decimals: usize) -> String {
+    format!("{:.d$} {:.d$} {:.d$}", v[0], v[1], v[2], d = decimals)
+}
+
+fn table(out: &mut String, title: &str, r: &TrialReport, cell: &dyn Fn(&JointFigures) -> Option<String>) {
+    let mut cols: Vec<(String, &Vec<JointFigures>)> = vec![("uncorrected".into(), &r.uncorrected)];
+    for v in &r.variants {
+        cols.push((v.variant.name().into(), &v.joints));
+    }
+    let rows: Vec<(String, Vec<String>)> = r
+        .uncorrected
+        .iter()
+        .map(|j| {
+            let cells = cols
+                .iter()
+                .map(|(_, figs)| {
+                    figs.iter()
+                        .find(|f| f.joint == j.joint)
+                        .and_then(cell)
+                        .unwrap_or_else(|| "-".into())
+                })
+                .collect();
+            (j.joint.clone(), cells)
+        })
+        .collect();
+    let jw = rows.iter().map(|(j, _)| j.len()).max().unwrap_or(5).max(5);
+    let widths: Vec<usize> = (0..cols.len())
+        .map(|c| {
+            rows.iter()
+                .map(|(_, cells)| cells[c].len())
+                .max()
+                .unwrap_or(0)
+                .max(cols[c].0.len())
+        })
+        .collect();
+    let _ = writeln!(out, "\n{title}");
+    let _ = write!(out, "{:<jw$}", "joint");
+    for (c, (name, _)) in cols.iter().enumerate() {
+        let _ = write!(out, "  {:>w$}", name, w = widths[c]);
+    }
+    out.push('\n');
+    for (joint, cells) in rows {
+        let _ = write!(out, "{joint:<jw$}");
+        for (c, cell) in cells.iter().enumerate() {
+            let _ = write!(out, "  {:>w$}", cell, w = widths[c]);
+        }
+        out.push('\n');
+    }
+}
+
+/// The report as aligned text tables for a terminal.
+pub fn format_text(r: &TrialReport) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{}: {} samples, {:.1} s at {:.1} Hz, {} IMUs; model {}; limits {} (sha256 {})",
+        r.trial,
+        r.samples,
+        r.duration_s,
+        r.rate_hz,
+        r.imus.len(),
+        r.model,
+        r.limits_source,
+        &r.limits_sha256[..12]
+    );
+    let _ = writeln!(
+        out,
+        "lambda1 {}, window {} s, hop {} s",
+        r.settings.lambda1, r.settings.window_s, r.settings.hop_s
+    );
+    for w in &r.warnings {
+        let _ = writeln!(out, "warning: {w}");
+    }
+    for v in &r.variants {
+        for s in &v.skipped {
+            let _ = writeln!(out, "{}: skipped {}: {}", v.variant, s.joint, s.reason);
+        }
+    }
+    table(&mut out, "Joint mean excursion, deg per sample (Figure 4-20)", r, &|f| {
+        Some(format!("{:.3}", f.excursion.joint_mean_excursion_deg))
+    });
+    table(&mut out, "Samples outside the limits, % per axis X Y Z (Table 4-1)", r, &|f| {
+        Some(xyz(f.excursion.pct_outside, 1))
+    });
+    table(&mut out, "Mean excursion, deg per sample per axis X Y Z (Table 4-2)", r, &|f| {
+        Some(xyz(f.excursion.mean_excursion_deg, 2))
+    });
+    if !r.variants.is_empty() {
+        table(&mut out, "Mean shift of the angles X Y Z | mean correction angle, deg (Table 4-3)", r, &|f| {
+            f.shift.map(|s| {
+                format!("{} | {:.2}", xyz(s.mean_shift_deg, 2), s.mean_correction_angle_deg)
+            })
+        });
+    }
+    if r.truth {
+        table(&mut out, "RMS error against truth, deg per axis X Y Z", r, &|f| {
+            f.truth.map(|t| xyz(t.rms_error_deg, 2))
+        });
+        table(&mut out, "Angle between applied and true correction, deg (mean)", r, &|f| {
+            f.truth.map(|t| format!("{:.2}", t.mean_correction_error_deg))
+        });
+    }
+    out
+}
