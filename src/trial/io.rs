@@ -1,21 +1,390 @@
-//! Reading and writing trial files (filled in by the trial I/O work).
+//! Reading and writing trial files.
+//!
+//! Formats (see [`TrialFormat`]):
+//!
+//! * canonical CSV: `time,<imu>_qw,<imu>_qx,<imu>_qy,<imu>_qz,...`, time in seconds,
+//!   quaternions scalar first, `G_R_imu`;
+//! * Euler CSV (CHR-UM6): `time,<imu>_roll,<imu>_pitch,<imu>_yaw,...` in degrees,
+//!   orientation `Rz(yaw) * Ry(pitch) * Rx(roll)`;
+//! * OpenSim `.sto` (OpenSense): `key=value` header lines up to `endheader`, a
+//!   tab-separated label line `time<TAB><imu>...`, then rows of time and one
+//!   `w,x,y,z` cell per IMU;
+//! * any of these gzip-compressed, when the name ends in `.gz`.
+//!
+//! `.csv` files are told apart by their header (`_qw` vs `_roll/_pitch/_yaw`).
+//! IMU names are mapped to canonical names with [`Model::canonical_imu`]; IMUs the
+//! model does not know are kept under the name found, with a warning.
 
 use super::{Trial, TrialError, TrialFormat};
 use crate::model::Model;
+use crate::rotation::{canonical, euler_zyx_deg};
+use std::fmt::Write as _;
+use std::io::{BufRead, BufReader, Read, Write as _};
 use std::path::Path;
 
-/// Reads a trial, picking the format from the file name (`.csv`, `.sto`, optionally `.gz`).
-pub fn read_trial(path: &Path, _model: &Model) -> Result<Trial, TrialError> {
-    Err(TrialError::file(
-        path.display().to_string(),
-        "reader not written yet",
-    ))
+mod parse;
+#[cfg(test)]
+mod tests;
+
+use parse::{classify_csv_header, first_nonblank, parse_header, parse_trial, LineIter};
+
+/// A cheap look at a trial file: its format and IMUs, without the samples.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TrialHeader {
+    pub format: TrialFormat,
+    /// Whether the file is gzip-compressed.
+    pub gzip: bool,
+    /// Canonical names of the IMUs the model knows, in file order.
+    pub imus: Vec<String>,
+    /// IMUs the model does not know, as named in the file (the engine ignores them).
+    pub unknown_imus: Vec<String>,
 }
 
-/// Writes a trial in `format`; gzip-compressed when the path ends in `.gz`. Atomic.
-pub fn write_trial(_trial: &Trial, path: &Path, _format: TrialFormat) -> Result<(), TrialError> {
-    Err(TrialError::file(
-        path.display().to_string(),
-        "writer not written yet",
-    ))
+/// Largest header [`read_trial_header`] and [`detect_format`] read before giving up.
+const HEAD_LIMIT: usize = 4 << 20;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Csv,
+    Sto,
+}
+
+/// `(kind, gzip)` from a file name, if it names a trial format.
+fn kind_of_name(path: &Path) -> Option<(Kind, bool)> {
+    let name = path.file_name()?.to_string_lossy().to_ascii_lowercase();
+    let (stem, gz) = match name.strip_suffix(".gz") {
+        Some(s) => (s, true),
+        None => (name.as_str(), false),
+    };
+    if stem.ends_with(".csv") && stem.len() > 4 {
+        Some((Kind::Csv, gz))
+    } else if stem.ends_with(".sto") && stem.len() > 4 {
+        Some((Kind::Sto, gz))
+    } else {
+        None
+    }
+}
+
+fn origin_of(path: &Path) -> String {
+    path.display().to_string()
+}
+
+fn name_of(origin: &str) -> String {
+    Path::new(origin)
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| origin.to_string())
+}
+
+fn kind_or_err(path: &Path) -> Result<(Kind, bool), TrialError> {
+    kind_of_name(path).ok_or_else(|| {
+        TrialError::file(
+            origin_of(path),
+            "unknown trial file type: expected a name ending in .csv, .sto, .csv.gz or .sto.gz",
+        )
+    })
+}
+
+/// True when `path`'s name is a trial file: it ends in `.csv`, `.sto`, `.csv.gz` or
+/// `.sto.gz` and is not a truth file (`*.truth.csv`, `*.truth.sto`, optionally `.gz`).
+/// Sidecars (`.json`), backups (`.bak`) and temporary files never qualify.
+pub fn is_trial_file(path: &Path) -> bool {
+    let Some(name) = path.file_name() else {
+        return false;
+    };
+    let name = name.to_string_lossy().to_ascii_lowercase();
+    let stem = name.strip_suffix(".gz").unwrap_or(&name);
+    if stem.ends_with(".truth.csv") || stem.ends_with(".truth.sto") {
+        return false;
+    }
+    kind_of_name(path).is_some()
+}
+
+fn cannot_read(origin: &str, e: std::io::Error) -> TrialError {
+    TrialError::file(origin, format!("cannot read: {e}"))
+}
+
+fn bad_gzip(origin: &str, e: std::io::Error) -> TrialError {
+    TrialError::file(
+        origin,
+        format!(
+            "invalid gzip data ({e}): expected a gzip-compressed file, as the name ends in .gz"
+        ),
+    )
+}
+
+/// Turns decompressed bytes into text, locating invalid UTF-8 by line and field.
+fn to_text(bytes: Vec<u8>, origin: &str, kind: Kind, gzip: bool) -> Result<String, TrialError> {
+    if !gzip && bytes.starts_with(&[0x1f, 0x8b]) {
+        return Err(TrialError::at(
+            origin,
+            1,
+            1,
+            "expected text, found gzip-compressed data (name the file *.gz to read it)",
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let at = e.utf8_error().valid_up_to().min(bytes.len());
+        let before = &bytes[..at];
+        let line = before.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+        let start = before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |i| i + 1);
+        let sep = if kind == Kind::Sto { b'\t' } else { b',' };
+        let column = before[start..].iter().filter(|&&b| b == sep).count() + 1;
+        TrialError::at(
+            origin,
+            line,
+            column,
+            format!(
+                "expected UTF-8 text, found invalid byte 0x{:02x}",
+                bytes[at.min(bytes.len().saturating_sub(1))]
+            ),
+        )
+    })
+}
+
+/// Reads and decompresses the whole file.
+fn read_text(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> {
+    let origin = origin_of(path);
+    let raw = std::fs::read(path).map_err(|e| cannot_read(&origin, e))?;
+    let bytes = if gzip {
+        let mut out = Vec::with_capacity(raw.len().saturating_mul(4));
+        flate2::read::MultiGzDecoder::new(&raw[..])
+            .read_to_end(&mut out)
+            .map_err(|e| bad_gzip(&origin, e))?;
+        out
+    } else {
+        raw
+    };
+    to_text(bytes, &origin, kind, gzip)
+}
+
+/// Reads only the header lines: for CSV the first non-blank line, for `.sto` up to
+/// the first non-blank line after `endheader`.
+fn read_head(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> {
+    let origin = origin_of(path);
+    let file = std::fs::File::open(path).map_err(|e| cannot_read(&origin, e))?;
+    let mut reader: Box<dyn BufRead> = if gzip {
+        Box::new(BufReader::new(flate2::read::MultiGzDecoder::new(
+            BufReader::new(file),
+        )))
+    } else {
+        Box::new(BufReader::new(file))
+    };
+    let mut buf = Vec::new();
+    let mut ended = kind == Kind::Csv;
+    loop {
+        let start = buf.len();
+        let n = reader
+            .by_ref()
+            .take((HEAD_LIMIT - start.min(HEAD_LIMIT)) as u64)
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| {
+                if gzip {
+                    bad_gzip(&origin, e)
+                } else {
+                    cannot_read(&origin, e)
+                }
+            })?;
+        if n == 0 || buf.len() >= HEAD_LIMIT {
+            break;
+        }
+        let line = buf[start..].trim_ascii();
+        if line.is_empty() {
+            continue;
+        }
+        if ended {
+            break;
+        }
+        if line.eq_ignore_ascii_case(b"endheader") {
+            ended = true;
+        }
+    }
+    to_text(buf, &origin, kind, gzip)
+}
+
+/// Format and compression of a trial file: `*.csv` is [`TrialFormat::QuatCsv`] or
+/// [`TrialFormat::EulerCsv`] as its header says (`_qw` columns vs
+/// `_roll/_pitch/_yaw`), `*.sto` is [`TrialFormat::Sto`]; each optionally `.gz`.
+/// Reads only the first line of a CSV file.
+pub fn detect_format(path: &Path) -> Result<(TrialFormat, bool), TrialError> {
+    let (kind, gzip) = kind_or_err(path)?;
+    match kind {
+        Kind::Sto => Ok((TrialFormat::Sto, gzip)),
+        Kind::Csv => {
+            let head = read_head(path, kind, gzip)?;
+            match first_nonblank(&head) {
+                Some(h) => Ok((classify_csv_header(h), gzip)),
+                None => Err(TrialError::at(
+                    origin_of(path),
+                    1,
+                    1,
+                    "empty file: expected a header line starting with 'time'",
+                )),
+            }
+        }
+    }
+}
+
+/// Reads a trial, picking the format from the file name (`.csv`, `.sto`,
+/// optionally `.gz`) and, for CSV, the header. `Trial::name` is the file name.
+pub fn read_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
+    let (kind, gzip) = kind_or_err(path)?;
+    let text = read_text(path, kind, gzip)?;
+    let format = match kind {
+        Kind::Sto => TrialFormat::Sto,
+        Kind::Csv => first_nonblank(&text).map_or(TrialFormat::QuatCsv, classify_csv_header),
+    };
+    let origin = origin_of(path);
+    parse_trial(&text, &origin, &name_of(&origin), format, model)
+}
+
+/// Reads a trial from text in `format`; `origin` names the file in errors, and its
+/// last path component becomes `Trial::name`.
+pub fn read_trial_from_str(
+    text: &str,
+    origin: &str,
+    format: TrialFormat,
+    model: &Model,
+) -> Result<Trial, TrialError> {
+    parse_trial(text, origin, &name_of(origin), format, model)
+}
+
+/// Reads only the header of a trial file: format, compression and IMU names.
+/// The header is checked as [`read_trial`] would check it.
+pub fn read_trial_header(path: &Path, model: &Model) -> Result<TrialHeader, TrialError> {
+    let (kind, gzip) = kind_or_err(path)?;
+    let head = read_head(path, kind, gzip)?;
+    let format = match kind {
+        Kind::Sto => TrialFormat::Sto,
+        Kind::Csv => first_nonblank(&head).map_or(TrialFormat::QuatCsv, classify_csv_header),
+    };
+    let origin = origin_of(path);
+    let layout = parse_header(&mut LineIter::new(&head), &origin, format, model)?;
+    let (known, unknown): (Vec<_>, Vec<_>) = layout.imus.into_iter().partition(|c| c.known);
+    Ok(TrialHeader {
+        format,
+        gzip,
+        imus: known.into_iter().map(|c| c.name).collect(),
+        unknown_imus: unknown.into_iter().map(|c| c.found).collect(),
+    })
+}
+
+/// Writes a trial in `format`; gzip-compressed when the path ends in `.gz`.
+/// Atomic, keeping the previous file as `<name>.bak` ([`crate::save::atomic_write`]).
+pub fn write_trial(trial: &Trial, path: &Path, format: TrialFormat) -> Result<(), TrialError> {
+    let origin = origin_of(path);
+    if let Some(bad) = trial
+        .imus
+        .iter()
+        .find(|s| s.orientation.len() != trial.time_s.len())
+    {
+        return Err(TrialError::file(
+            origin,
+            format!(
+                "cannot write: IMU '{}' has {} samples, expected one per time ({})",
+                bad.name,
+                bad.orientation.len(),
+                trial.time_s.len()
+            ),
+        ));
+    }
+    let (kind, gzip) = match kind_of_name(path) {
+        Some((k, gz)) => (Some(k), gz),
+        None => (
+            None,
+            path.to_string_lossy().to_ascii_lowercase().ends_with(".gz"),
+        ),
+    };
+    let wanted = if format == TrialFormat::Sto {
+        Kind::Sto
+    } else {
+        Kind::Csv
+    };
+    if kind.is_some_and(|k| k != wanted) {
+        return Err(TrialError::file(
+            origin,
+            format!(
+                "cannot write {format:?} to this file name: expected a name ending in .{}",
+                if wanted == Kind::Sto { "sto" } else { "csv" }
+            ),
+        ));
+    }
+    let text = trial_to_string(trial, format);
+    let bytes = if gzip {
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        enc.write_all(text.as_bytes())
+            .and_then(|_| enc.finish())
+            .map_err(|e| TrialError::file(origin.clone(), format!("cannot compress: {e}")))?
+    } else {
+        text.into_bytes()
+    };
+    crate::save::atomic_write(path, &bytes)
+        .map_err(|e| TrialError::file(origin, format!("cannot write: {e}")))
+}
+
+/// The text of a trial in `format` (uncompressed). Numbers use Rust's shortest
+/// round-trip formatting; quaternions are written with `w >= 0`.
+pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
+    let n = trial
+        .imus
+        .iter()
+        .map(|s| s.orientation.len())
+        .fold(trial.time_s.len(), usize::min);
+    let per_row = 12 + trial.imus.len() * 4 * 22;
+    let mut out = String::with_capacity(256 + n * per_row);
+    // Writing into a String cannot fail.
+    match format {
+        TrialFormat::QuatCsv | TrialFormat::EulerCsv => {
+            let suffixes: &[&str] = if format == TrialFormat::QuatCsv {
+                &["qw", "qx", "qy", "qz"]
+            } else {
+                &["roll", "pitch", "yaw"]
+            };
+            out.push_str("time");
+            for s in &trial.imus {
+                for suf in suffixes {
+                    let _ = write!(out, ",{}_{suf}", s.name);
+                }
+            }
+            out.push('\n');
+            for i in 0..n {
+                let _ = write!(out, "{}", trial.time_s[i]);
+                for s in &trial.imus {
+                    let q = &s.orientation[i];
+                    if format == TrialFormat::QuatCsv {
+                        let q = canonical(q);
+                        let _ = write!(out, ",{},{},{},{}", q.w, q.i, q.j, q.k);
+                    } else {
+                        let [r, p, y] = euler_zyx_deg(q);
+                        let _ = write!(out, ",{r},{p},{y}");
+                    }
+                }
+                out.push('\n');
+            }
+        }
+        TrialFormat::Sto => {
+            let _ = write!(
+                out,
+                "\nDataRate={:.6}\nDataType=Quaternion\nversion=3\nOpenSimVersion=4.1\nendheader\ntime",
+                trial.rate_hz()
+            );
+            for s in &trial.imus {
+                let _ = write!(out, "\t{}", s.name);
+            }
+            out.push('\n');
+            for i in 0..n {
+                let _ = write!(out, "{}", trial.time_s[i]);
+                for s in &trial.imus {
+                    let q = canonical(&s.orientation[i]);
+                    let _ = write!(out, "\t{},{},{},{}", q.w, q.i, q.j, q.k);
+                }
+                out.push('\n');
+            }
+        }
+    }
+    out
 }
