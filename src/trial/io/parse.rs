@@ -446,7 +446,6 @@ impl<'a> Acc<'a> {
         Ok(())
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn push_quat(
         &mut self,
         k: usize,
