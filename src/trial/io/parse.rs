@@ -245,16 +245,18 @@ pub(crate) fn parse_csv_header(
         let field = &columns[k];
         let prefix = match split_suffix(field) {
             Some((p, s)) if !p.is_empty() && s.eq_ignore_ascii_case(suffixes[0]) => p,
-            _ => return Err(TrialError::at(
-                origin,
-                line,
-                k + 1,
-                format!(
+            _ => {
+                return Err(TrialError::at(
+                    origin,
+                    line,
+                    k + 1,
+                    format!(
                     "expected a column '<imu>_{}' starting an IMU's columns {pattern}, found {}",
                     suffixes[0],
                     show(field)
                 ),
-            )),
+                ))
+            }
         };
         for (j, s) in suffixes.iter().enumerate().skip(1) {
             let want = format!("{prefix}_{s}");
@@ -397,6 +399,7 @@ pub(crate) fn parse_header(
 #[derive(Default, Clone)]
 struct Renorm {
     count: usize,
+    worst_off: f64,
     worst_norm: f64,
     worst_line: u64,
 }
@@ -443,7 +446,6 @@ impl<'a> Acc<'a> {
         Ok(())
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn push_quat(
         &mut self,
         k: usize,
@@ -475,7 +477,8 @@ impl<'a> Acc<'a> {
         if off > NORM_NOTE {
             let r = &mut self.renorm[k];
             r.count += 1;
-            if off > (r.worst_norm - 1.0).abs() {
+            if off > r.worst_off {
+                r.worst_off = off;
                 r.worst_norm = n;
                 r.worst_line = line;
             }
