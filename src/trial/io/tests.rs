@@ -719,18 +719,14 @@ fn trial_header_only_reads_header() {
 }
 
 #[test]
-fn trial_large_csv_reads_quickly() {
-    // 5 minutes at 50 Hz, 13 IMUs: 15,000 rows x 53 columns.
+fn trial_large_csv_reads_back() {
+    // 5 minutes at 50 Hz, 13 IMUs: 15,000 rows x 53 columns (speed: benches/).
     let names = infant().imus;
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
     let trial = random_trial(&names, 15_000, 5);
     let text = trial_to_string(&trial, Q);
     assert!(text.len() > 7_000_000, "{}", text.len());
-    let start = std::time::Instant::now();
     let back = read_trial_from_str(&text, "big.csv", Q, &infant()).unwrap();
-    let took = start.elapsed();
-    eprintln!("read {} bytes in {took:?}", text.len());
     assert_eq!(back.len(), 15_000);
-    // Generous bound for a shared machine; release builds take well under 100 ms.
-    assert!(took.as_secs_f64() < 2.0, "{took:?}");
+    assert_eq!(back.time_s, trial.time_s);
 }
