@@ -8,4 +8,6 @@ pub mod limits;
 pub mod model;
 pub mod rotation;
 pub mod save;
+pub mod simulate;
 pub mod trial;
+pub mod truth;
