@@ -1,11 +1,287 @@
-//! `acmw simulate`: write a simulated trial and its truth.
+//! `acmw simulate`: write a simulated trial and its truth beside it.
 
-use clap::Args;
+use acm_workbench::simulate::{
+    self, HeadingDrift, ImuMisalignment, KneeAxis, KneeImu, Misalignment, SimConfig,
+    RANDOM_MISALIGNMENT_DEG,
+};
+use acm_workbench::truth::{self, Truth};
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use std::path::{Path, PathBuf};
+
+/// Exit code of a configuration that cannot be simulated (a usage error).
+const EXIT_USAGE: i32 = 2;
 
 #[derive(Debug, Args)]
-pub struct SimulateArgs {}
+pub struct SimulateArgs {
+    #[command(subcommand)]
+    pub what: What,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum What {
+    /// Thesis 4.1 knee test: static thigh, calf flexing 15-75 deg at 5 cycles/min,
+    /// one IMU misaligned about X or Z (IMUs l_thigh and l_calf).
+    Knee(KneeArgs),
+    /// The 13 IMUs of infant13: crawling-like motion, random 5-30 deg misalignment
+    /// of every non-base IMU, optional heading drift, noise.
+    FullBody(FullBodyArgs),
+    /// A named configuration (knee_calf_z15, full_body_clean, full_body_drift);
+    /// the common options override it.
+    Preset(PresetArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct KneeArgs {
+    /// The misaligned IMU.
+    #[arg(long, value_enum, default_value = "calf")]
+    pub imu: KneeImu,
+    /// The sensor axis of the misalignment.
+    #[arg(long, value_enum, default_value = "z")]
+    pub axis: KneeAxis,
+    /// Misalignment angle, degrees.
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true)]
+    pub angle: f64,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct FullBodyArgs {
+    /// Smallest and largest random misalignment angle, degrees.
+    #[arg(long, num_args = 2, value_names = ["MIN", "MAX"])]
+    pub misalign_range: Option<Vec<f64>>,
+    /// Misalign only the given IMUs instead, by a rotation vector in degrees in the
+    /// sensor frame, IMU:X:Y:Z (repeatable).
+    #[arg(long = "misalign", value_parser = parse_misalignment, allow_hyphen_values = true)]
+    pub misalign: Vec<ImuMisalignment>,
+    /// No misalignment at all.
+    #[arg(long, conflicts_with_all = ["misalign", "misalign_range"])]
+    pub aligned: bool,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct PresetArgs {
+    /// Preset name.
+    #[arg(value_parser = simulate::PRESETS)]
+    pub name: String,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct CommonArgs {
+    /// Trial length, seconds [default: 300, preset's for a preset].
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// Sampling rate, Hz [default: 50].
+    #[arg(long)]
+    pub rate: Option<f64>,
+    /// Random seed [default: 0].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// RMS orientation noise per sample, degrees [default: 0 for knee, 0.3 full body].
+    #[arg(long)]
+    pub noise: Option<f64>,
+    /// Heading drift IMU:START_S:RATE_DEG_S about the global vertical (repeatable).
+    #[arg(long, value_parser = parse_drift, allow_hyphen_values = true)]
+    pub drift: Vec<HeadingDrift>,
+    /// Output trial file (`.csv` or `.csv.gz`); the truth goes beside it.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+fn parse_drift(s: &str) -> Result<HeadingDrift, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let [imu, start, rate] = parts[..] else {
+        return Err(format!("expected IMU:START_S:RATE_DEG_S, found '{s}'"));
+    };
+    let num = |v: &str, what: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("{what} '{v}' is not a number"))
+    };
+    Ok(HeadingDrift {
+        imu: imu.trim().to_string(),
+        start_s: num(start, "start")?,
+        rate_deg_s: num(rate, "rate")?,
+    })
+}
+
+fn parse_misalignment(s: &str) -> Result<ImuMisalignment, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let [imu, x, y, z] = parts[..] else {
+        return Err(format!("expected IMU:X:Y:Z (degrees), found '{s}'"));
+    };
+    let num = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{v}' is not a number"))
+    };
+    Ok(ImuMisalignment {
+        imu: imu.trim().to_string(),
+        rotvec_deg: [num(x)?, num(y)?, num(z)?],
+    })
+}
+
+impl CommonArgs {
+    fn apply(&self, cfg: &mut SimConfig) {
+        if let Some(d) = self.duration {
+            cfg.duration_s = d;
+        }
+        if let Some(r) = self.rate {
+            cfg.rate_hz = r;
+        }
+        if let Some(s) = self.seed {
+            cfg.seed = s;
+        }
+        if let Some(n) = self.noise {
+            cfg.noise_deg = n;
+        }
+        if !self.drift.is_empty() {
+            cfg.drifts = self.drift.clone();
+        }
+    }
+}
 
 /// Runs `acmw simulate`.
-pub fn run(_args: SimulateArgs) -> anyhow::Result<i32> {
-    anyhow::bail!("not written yet")
+pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
+    let (mut cfg, common) = match args.what {
+        What::Knee(a) => (SimConfig::knee(a.imu, a.axis, a.angle), a.common),
+        What::FullBody(a) => {
+            let mut cfg = SimConfig::full_body(0);
+            cfg.misalignment = if a.aligned {
+                Misalignment::None
+            } else if !a.misalign.is_empty() {
+                Misalignment::Fixed { imus: a.misalign }
+            } else {
+                let r = a.misalign_range.unwrap_or(RANDOM_MISALIGNMENT_DEG.to_vec());
+                Misalignment::Random {
+                    min_deg: r[0],
+                    max_deg: r[1],
+                }
+            };
+            (cfg, a.common)
+        }
+        What::Preset(a) => (
+            simulate::preset(&a.name).context("unknown preset")?,
+            a.common,
+        ),
+    };
+    common.apply(&mut cfg);
+    let out = &common.output;
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if !(name.ends_with(".csv") || name.ends_with(".csv.gz")) || truth::is_truth_file(out) {
+        eprintln!(
+            "acmw: the output must be a trial file ending in .csv or .csv.gz (not a .truth file), found '{}'",
+            out.display()
+        );
+        return Ok(EXIT_USAGE);
+    }
+    let sim = match simulate::simulate(&cfg) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("acmw: {e}");
+            return Ok(EXIT_USAGE);
+        }
+    };
+    let mut trial = sim.trial;
+    trial.name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let (truth_csv, truth_json) = save(&trial, &sim.truth, out)?;
+
+    println!(
+        "wrote {}: {} IMUs, {} samples ({} s at {} Hz), seed {}, noise {} deg",
+        out.display(),
+        trial.imus.len(),
+        trial.len(),
+        cfg.duration_s,
+        cfg.rate_hz,
+        cfg.seed,
+        cfg.noise_deg
+    );
+    let misaligned: Vec<String> = sim
+        .truth
+        .meta
+        .misalignments
+        .iter()
+        .filter_map(|(imu, q)| {
+            let a =
+                acm_workbench::rotation::angle_deg(&acm_workbench::rotation::quat_from_wxyz(*q));
+            (a > 1e-9).then(|| format!("{imu} {a:.1}"))
+        })
+        .collect();
+    if misaligned.is_empty() {
+        println!("  misalignment: none");
+    } else {
+        println!("  misalignment (deg): {}", misaligned.join(", "));
+    }
+    for d in &cfg.drifts {
+        println!(
+            "  heading drift: {} from {} s at {} deg/s",
+            d.imu, d.start_s, d.rate_deg_s
+        );
+    }
+    println!("wrote {} (segment orientations)", truth_csv.display());
+    println!(
+        "wrote {} (configuration, misalignments, drifts)",
+        truth_json.display()
+    );
+    Ok(0)
+}
+
+/// Writes the trial and its truth files; returns the truth paths.
+///
+/// TODO(merge with trial I/O): replace the body with
+/// `write_trial(trial, out, TrialFormat::QuatCsv)` and `truth.save_beside(out)`,
+/// and delete [`write_quat_csv`].
+fn save(
+    trial: &acm_workbench::trial::Trial,
+    truth: &Truth,
+    out: &Path,
+) -> anyhow::Result<(PathBuf, PathBuf)> {
+    let (truth_csv, truth_json) = truth::truth_paths(out);
+    write_quat_csv(trial, out)?;
+    write_quat_csv(&truth.segments, &truth_csv)?;
+    truth.meta.save(&truth_json)?;
+    Ok((truth_csv, truth_json))
+}
+
+/// Stand-in for `trial::write_trial(.., TrialFormat::QuatCsv)` until the trial I/O
+/// lands: `time,<imu>_qw,<imu>_qx,<imu>_qy,<imu>_qz,...`, shortest round-trip
+/// numbers, `w >= 0`, gzip when the name ends in `.gz`, atomic.
+fn write_quat_csv(trial: &acm_workbench::trial::Trial, path: &Path) -> anyhow::Result<()> {
+    use std::fmt::Write as _;
+    use std::io::Write as _;
+    let mut text = String::from("time");
+    for s in &trial.imus {
+        for c in ["qw", "qx", "qy", "qz"] {
+            let _ = write!(text, ",{}_{c}", s.name);
+        }
+    }
+    text.push('\n');
+    for (i, t) in trial.time_s.iter().enumerate() {
+        let _ = write!(text, "{t}");
+        for s in &trial.imus {
+            let q = acm_workbench::rotation::canonical(&s.orientation[i]);
+            let _ = write!(text, ",{},{},{},{}", q.w, q.i, q.j, q.k);
+        }
+        text.push('\n');
+    }
+    let bytes = if path.to_string_lossy().to_ascii_lowercase().ends_with(".gz") {
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        enc.write_all(text.as_bytes())?;
+        enc.finish()?
+    } else {
+        text.into_bytes()
+    };
+    acm_workbench::save::atomic_write(path, &bytes)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
