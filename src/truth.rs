@@ -102,6 +102,38 @@ impl Truth {
             .collect()
     }
 
+    /// Checks that `measured` pairs with this truth sample by sample: same number
+    /// of samples, same times (within 1 microsecond), and every measured IMU in
+    /// the truth. The error says what differs.
+    pub fn check_against(&self, measured: &Trial) -> Result<(), String> {
+        if measured.len() != self.segments.len() {
+            return Err(format!(
+                "the truth has {} samples, the trial {}",
+                self.segments.len(),
+                measured.len()
+            ));
+        }
+        if let Some((i, (a, b))) = measured
+            .time_s
+            .iter()
+            .zip(&self.segments.time_s)
+            .enumerate()
+            .find(|(_, (a, b))| (*a - *b).abs() > 1e-6)
+        {
+            return Err(format!(
+                "sample {i}: the trial's time is {a} s, the truth's {b} s"
+            ));
+        }
+        if let Some(s) = measured
+            .imus
+            .iter()
+            .find(|s| self.segments.imu(&s.name).is_none())
+        {
+            return Err(format!("IMU '{}' has no truth", s.name));
+        }
+        Ok(())
+    }
+
     /// Saves `NAME.truth.csv.gz` and `NAME.truth.json` beside `trial_path`;
     /// returns their paths.
     pub fn save_beside(&self, trial_path: &Path) -> Result<(PathBuf, PathBuf), TrialError> {
@@ -207,6 +239,21 @@ mod tests {
         assert_eq!(back.config, sim.truth.meta.config);
         assert_eq!(back.drifts, sim.truth.meta.drifts);
         assert_eq!(back.misalignments.len(), 13);
+        sim.truth.check_against(&sim.trial).unwrap();
+        let mut short = sim.trial.clone();
+        short.time_s.pop();
+        assert!(sim
+            .truth
+            .check_against(&short)
+            .unwrap_err()
+            .contains("samples"));
+        let mut shifted = sim.trial.clone();
+        shifted.time_s[3] += 0.001;
+        assert!(sim
+            .truth
+            .check_against(&shifted)
+            .unwrap_err()
+            .contains("sample 3"));
         // serde_json parses floats to within an ulp, not always bit for bit.
         for imu in sim.truth.meta.misalignments.keys() {
             let (a, b) = (back.misalignment(imu), sim.truth.meta.misalignment(imu));

@@ -285,3 +285,52 @@ fn write_quat_csv(trial: &acm_workbench::trial::Trial, path: &Path) -> anyhow::R
     acm_workbench::save::atomic_write(path, &bytes)
         .with_context(|| format!("cannot write {}", path.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn simulate_cli_parses_drift_and_misalignment() {
+        let d = parse_drift("l_calf:60:0.05").unwrap();
+        assert_eq!(
+            (d.imu.as_str(), d.start_s, d.rate_deg_s),
+            ("l_calf", 60.0, 0.05)
+        );
+        assert_eq!(parse_drift("r_foot:0:-0.1").unwrap().rate_deg_s, -0.1);
+        assert!(parse_drift("l_calf:60").is_err());
+        assert!(parse_drift("l_calf:x:1").unwrap_err().contains("start"));
+        let m = parse_misalignment("head:0:-20:5").unwrap();
+        assert_eq!((m.imu.as_str(), m.rotvec_deg), ("head", [0.0, -20.0, 5.0]));
+        assert!(parse_misalignment("head:1:2").is_err());
+    }
+
+    #[test]
+    fn simulate_cli_writes_trial_and_truth() {
+        use clap::Parser;
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("k.csv.gz");
+        let cli = crate::cli::Cli::try_parse_from([
+            "acmw",
+            "simulate",
+            "knee",
+            "--imu",
+            "calf",
+            "--axis",
+            "z",
+            "--angle",
+            "15",
+            "--duration",
+            "2",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .unwrap();
+        assert_eq!(crate::cli::run(cli), 0);
+        assert!(out.exists());
+        assert!(dir.path().join("k.truth.csv.gz").exists());
+        let json = std::fs::read_to_string(dir.path().join("k.truth.json")).unwrap();
+        let meta = acm_workbench::truth::TruthMeta::from_json(&json, "k.truth.json").unwrap();
+        assert_eq!(meta.config.duration_s, 2.0);
+    }
+}
