@@ -1,8 +1,8 @@
 //! acm-workbench: the Anatomical Constraint Method for IMU joint angles.
 //!
 //! The numerical core (`rotation`, `model`, `limits`, `trial`, `acm`, `metrics`,
-//! `sidecar`, `simulate`) knows nothing of the terminal; `ui` and the `acmw`
-//! binary are thin layers over it.
+//! `sidecar`, `simulate`, `truth`) knows nothing of the terminal; `ui` and the
+//! `acmw` binary are thin layers over it.
 
 pub mod acm;
 pub mod limits;
@@ -12,4 +12,6 @@ pub mod report;
 pub mod rotation;
 pub mod save;
 pub mod sidecar;
+pub mod simulate;
 pub mod trial;
+pub mod truth;

@@ -184,7 +184,12 @@ mod tests {
 
     #[test]
     fn excursion_figures_by_hand() {
-        let a = [[0.0, 10.0, 0.0], [7.0, -2.0, 0.0], [0.0, 140.0, -6.0], [0.0, 50.0, 0.0]];
+        let a = [
+            [0.0, 10.0, 0.0],
+            [7.0, -2.0, 0.0],
+            [0.0, 140.0, -6.0],
+            [0.0, 50.0, 0.0],
+        ];
         let f = excursion_figures(&a, &knee());
         assert_eq!(f.pct_outside, [25.0, 50.0, 25.0]);
         assert_eq!(f.mean_excursion_deg, [0.5, 3.0, 0.25]);

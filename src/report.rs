@@ -67,7 +67,13 @@ impl ReportInput<'_> {
                 .iter()
                 .map(|c| VariantReport {
                     variant: c.variant,
-                    joints: trial_figures(&c.corrected, Some(t), self.truth, self.model, self.limits),
+                    joints: trial_figures(
+                        &c.corrected,
+                        Some(t),
+                        self.truth,
+                        self.model,
+                        self.limits,
+                    ),
                     skipped: c.skipped.clone(),
                 })
                 .collect(),
@@ -76,10 +82,23 @@ impl ReportInput<'_> {
     }
 
     /// Runs each variant, then reports.
-    pub fn run(&self, variants: &[Variant], control: &RunControl) -> Result<TrialReport, Cancelled> {
+    pub fn run(
+        &self,
+        variants: &[Variant],
+        control: &RunControl,
+    ) -> Result<TrialReport, Cancelled> {
         let corrections = variants
             .iter()
-            .map(|&v| correct_trial(self.trial, self.model, self.limits, self.settings, v, control))
+            .map(|&v| {
+                correct_trial(
+                    self.trial,
+                    self.model,
+                    self.limits,
+                    self.settings,
+                    v,
+                    control,
+                )
+            })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(self.report(&corrections))
     }
@@ -89,7 +108,12 @@ fn xyz(v: [f64; 3], decimals: usize) -> String {
     format!("{:.d$} {:.d$} {:.d$}", v[0], v[1], v[2], d = decimals)
 }
 
-fn table(out: &mut String, title: &str, r: &TrialReport, cell: &dyn Fn(&JointFigures) -> Option<String>) {
+fn table(
+    out: &mut String,
+    title: &str,
+    r: &TrialReport,
+    cell: &dyn Fn(&JointFigures) -> Option<String>,
+) {
     let mut cols: Vec<(String, &Vec<JointFigures>)> = vec![("uncorrected".into(), &r.uncorrected)];
     for v in &r.variants {
         cols.push((v.variant.name().into(), &v.joints));
@@ -163,29 +187,56 @@ pub fn format_text(r: &TrialReport) -> String {
             let _ = writeln!(out, "{}: skipped {}: {}", v.variant, s.joint, s.reason);
         }
     }
-    table(&mut out, "Joint mean excursion, deg per sample (Figure 4-20)", r, &|f| {
-        Some(format!("{:.3}", f.excursion.joint_mean_excursion_deg))
-    });
-    table(&mut out, "Samples outside the limits, % per axis X Y Z (Table 4-1)", r, &|f| {
-        Some(xyz(f.excursion.pct_outside, 1))
-    });
-    table(&mut out, "Mean excursion, deg per sample per axis X Y Z (Table 4-2)", r, &|f| {
-        Some(xyz(f.excursion.mean_excursion_deg, 2))
-    });
+    table(
+        &mut out,
+        "Joint mean excursion, deg per sample (Figure 4-20)",
+        r,
+        &|f| Some(format!("{:.3}", f.excursion.joint_mean_excursion_deg)),
+    );
+    table(
+        &mut out,
+        "Samples outside the limits, % per axis X Y Z (Table 4-1)",
+        r,
+        &|f| Some(xyz(f.excursion.pct_outside, 1)),
+    );
+    table(
+        &mut out,
+        "Mean excursion, deg per sample per axis X Y Z (Table 4-2)",
+        r,
+        &|f| Some(xyz(f.excursion.mean_excursion_deg, 2)),
+    );
     if !r.variants.is_empty() {
-        table(&mut out, "Mean shift of the angles X Y Z | mean correction angle, deg (Table 4-3)", r, &|f| {
-            f.shift.map(|s| {
-                format!("{} | {:.2}", xyz(s.mean_shift_deg, 2), s.mean_correction_angle_deg)
-            })
-        });
+        table(
+            &mut out,
+            "Mean shift of the angles X Y Z | mean correction angle, deg (Table 4-3)",
+            r,
+            &|f| {
+                f.shift.map(|s| {
+                    format!(
+                        "{} | {:.2}",
+                        xyz(s.mean_shift_deg, 2),
+                        s.mean_correction_angle_deg
+                    )
+                })
+            },
+        );
     }
     if r.truth {
-        table(&mut out, "RMS error against truth, deg per axis X Y Z", r, &|f| {
-            f.truth.map(|t| xyz(t.rms_error_deg, 2))
-        });
-        table(&mut out, "Angle between applied and true correction, deg (mean)", r, &|f| {
-            f.truth.map(|t| format!("{:.2}", t.mean_correction_error_deg))
-        });
+        table(
+            &mut out,
+            "RMS error against truth, deg per axis X Y Z",
+            r,
+            &|f| f.truth.map(|t| xyz(t.rms_error_deg, 2)),
+        );
+        table(
+            &mut out,
+            "Angle between applied and true correction, deg (mean)",
+            r,
+            &|f| {
+                f.truth
+                    .map(|t| format!("{:.2}", t.mean_correction_error_deg))
+            },
+        );
     }
     out
 }

@@ -8,8 +8,8 @@ use acm_workbench::acm::window::layout;
 use acm_workbench::acm::{correct_trial, RunControl, Variant};
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::Model;
-use acm_workbench::rotation::{quat_axis_angle_deg, quat_from_euler_zyx_deg, quat_from_wxyz, Quat};
-use acm_workbench::trial::{ImuSeries, Trial};
+use acm_workbench::rotation::{quat_from_wxyz, Quat};
+use acm_workbench::simulate::{preset, simulate};
 use nalgebra::Vector3;
 
 /// Dense search: a grid of rotation vectors up to `radius_deg`, spacing
@@ -40,72 +40,26 @@ fn dense_best(cost: &WindowCost, radius_deg: f64, step_deg: f64) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// Two-minute, 50 Hz trial of `model`'s joints `names`, segments moving through
-/// `angles(t)` per joint, the distal IMU of each misaligned by `misalign`.
-fn build_trial(
-    model: &Model,
-    joints: &[(&str, fn(f64) -> [f64; 3], Quat)],
-    seconds: f64,
-) -> Trial {
-    let time_s: Vec<f64> = (0..(seconds * 50.0) as usize).map(|i| i as f64 / 50.0).collect();
-    let mut segments: Vec<(String, Vec<Quat>)> = vec![(
-        model.base.clone(),
-        time_s
-            .iter()
-            .map(|t| quat_axis_angle_deg([0.0, 0.0, 1.0], 20.0 * (0.1 * t).sin()))
-            .collect(),
-    )];
-    let mut imus = vec![ImuSeries {
-        name: model.base.clone(),
-        orientation: segments[0].1.clone(),
-    }];
-    for (name, angles, misalign) in joints {
-        let j = model.joint(name).unwrap();
-        let parent = segments.iter().find(|(n, _)| *n == j.proximal).unwrap().1.clone();
-        let seg: Vec<Quat> = parent
-            .iter()
-            .zip(&time_s)
-            .map(|(p, &t)| p * quat_from_euler_zyx_deg(angles(t)))
-            .collect();
-        imus.push(ImuSeries {
-            name: j.distal.clone(),
-            orientation: seg.iter().map(|s| s * misalign).collect(),
-        });
-        segments.push((j.distal.clone(), seg));
-    }
-    Trial {
-        name: "built".into(),
-        time_s,
-        imus,
-        warnings: vec![],
-    }
-}
-
-fn hip(t: f64) -> [f64; 3] {
-    [-5.0 + 20.0 * (0.7 * t).sin(), 20.0 + 40.0 * (0.5 * t).sin(), 5.0 + 20.0 * (0.9 * t + 1.0).sin()]
-}
-
-fn knee(t: f64) -> [f64; 3] {
-    [0.0, 45.0 + 30.0 * (2.0 * std::f64::consts::PI * t / 12.0).sin(), 0.0]
-}
-
 #[test]
 fn every_window_reaches_the_dense_search_optimum() {
     let model = Model::infant13();
     let table = LimitTable::default_table();
-    let trial = build_trial(
-        &model,
-        &[
-            ("l_hip", hip, quat_axis_angle_deg([1.0, -0.5, 0.3], 20.0)),
-            ("l_knee", knee, quat_axis_angle_deg([0.2, 0.1, 1.0], 15.0)),
-        ],
-        120.0,
-    );
+    // 13 IMUs, 90 s (two windows), every non-base IMU misaligned 5-30 deg.
+    let trial = simulate(&preset("full_body_clean").unwrap()).unwrap().trial;
     let settings = Settings::default();
     for variant in [Variant::Drift, Variant::DriftCentroid] {
-        let run = correct_trial(&trial, &model, &table, &settings, variant, &RunControl::default())
-            .unwrap();
+        let run = correct_trial(
+            &trial,
+            &model,
+            &table,
+            &settings,
+            variant,
+            &RunControl::default(),
+        )
+        .unwrap();
         let windows = layout(&trial.time_s, settings.window_s, settings.hop_s);
+        assert_eq!(windows.len(), 2);
+        assert_eq!(run.joints.len(), 12);
         for jr in &run.joints {
             let joint = model.joint(&jr.joint).unwrap();
             let lim = table
@@ -113,7 +67,11 @@ fn every_window_reaches_the_dense_search_optimum() {
                 .unwrap();
             let parent = &run.corrected.imu(&joint.proximal).unwrap().orientation;
             let child = &trial.imu(&joint.distal).unwrap().orientation;
-            let measured: Vec<Quat> = parent.iter().zip(child).map(|(p, c)| p.inverse() * c).collect();
+            let measured: Vec<Quat> = parent
+                .iter()
+                .zip(child)
+                .map(|(p, c)| p.inverse() * c)
+                .collect();
             for (w, sol) in windows.iter().zip(&jr.windows) {
                 let cost = WindowCost::new(&measured[w.first..w.end], &lim, settings.lambda1);
                 let engine = cost.eval(&quat_from_wxyz(sol.correction));

@@ -8,7 +8,9 @@
 use super::cost::WindowCost;
 use super::minimise::{minimise, MinimiseOptions, Solution};
 use super::window::{correction_series, layout, whole_trial, Window};
-use super::{Cancelled, Correction, JointResult, RunControl, SkippedJoint, Variant, WindowSolution};
+use super::{
+    Cancelled, Correction, JointResult, RunControl, SkippedJoint, Variant, WindowSolution,
+};
 use crate::limits::{JointLimits, LimitTable, Settings};
 use crate::model::{Joint, Model};
 use crate::rotation::{angle_deg, canonical, quat_from_wxyz, wxyz, Quat};
@@ -74,7 +76,10 @@ fn skip_reason(trial: &Trial, joint: &Joint, limits: &LimitTable) -> Option<Stri
             return Some(format!("IMU '{imu}' is not in the trial"));
         }
     }
-    if limits.joint_limits(&joint.name, &joint.kind, false).is_none() {
+    if limits
+        .joint_limits(&joint.name, &joint.kind, false)
+        .is_none()
+    {
         return Some(format!("the limit table has no rows for '{}'", joint.kind));
     }
     None
@@ -190,9 +195,7 @@ fn run(
 }
 
 fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &str) -> bool {
-    results
-        .keys()
-        .any(|&k| model.joints[k].distal == imu)
+    results.keys().any(|&k| model.joints[k].distal == imu)
 }
 
 /// The per-sample correction a previous run applied to `imu`: `raw^-1 * corrected`.

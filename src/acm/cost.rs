@@ -46,7 +46,9 @@ pub fn cost_direct(measured: &[Quat], c: &Quat, limits: &JointLimits, lambda1: f
         .iter()
         .map(|qm| {
             let qt = qm * c;
-            let e: f64 = excursion(euler_zyx_deg(&qt), &limits.range_deg).iter().sum();
+            let e: f64 = excursion(euler_zyx_deg(&qt), &limits.range_deg)
+                .iter()
+                .sum();
             match centroid {
                 Some(qc) if limits.lambda2 > 0.0 => e + limits.lambda2 * rmsq(&qt, &qc),
                 _ => e,

@@ -120,7 +120,8 @@ fn descend(
             .iter()
             .map(|(v, _)| (v - simplex[0].0).amax())
             .fold(0.0, f64::max);
-        if (size < opts.tol_x_rad && spread < opts.tol_f.max(1e-15)) || size < opts.tol_x_rad * 1e-3 {
+        if (size < opts.tol_x_rad && spread < opts.tol_f.max(1e-15)) || size < opts.tol_x_rad * 1e-3
+        {
             break;
         }
         if evals.get() >= opts.max_evals_per_descent {
@@ -133,7 +134,11 @@ fn descend(
         if fr < simplex[0].1 {
             let expanded = centroid + (centroid - worst.0) * 2.0;
             let fe = f(&expanded);
-            simplex[3] = if fe < fr { (expanded, fe) } else { (reflected, fr) };
+            simplex[3] = if fe < fr {
+                (expanded, fe)
+            } else {
+                (reflected, fr)
+            };
         } else if fr < simplex[2].1 {
             simplex[3] = (reflected, fr);
         } else {
@@ -189,7 +194,10 @@ mod tests {
         let cost = |c: &Quat| angle_between_deg(c, &far);
         let s = minimise(
             &cost,
-            &[Quat::identity(), quat_axis_angle_deg([0.0, 1.0, 0.0], 160.0)],
+            &[
+                Quat::identity(),
+                quat_axis_angle_deg([0.0, 1.0, 0.0], 160.0),
+            ],
             &MinimiseOptions::default(),
         );
         assert!(s.cost < 1e-3, "{s:?}");

@@ -66,7 +66,9 @@ pub fn detect_model(trial: &Path) -> Model {
 pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<Context> {
     if let Some(n) = args.threads {
         // Ignore the error of a pool already built (tests call this twice).
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
     }
     let model = match (&args.model, trial) {
         (Some(m), _) => Model::load(m)?,

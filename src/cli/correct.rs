@@ -63,7 +63,9 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             let s = Sidecar::load(p)?;
             let limits = s.table()?;
             if let Some(n) = args.engine.threads {
-                let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+                let _ = rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build_global();
             }
             let ctx = Context {
                 model: s.model.clone(),
@@ -93,14 +95,32 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         cancel: None,
         progress: Some(&report),
     };
-    let correction = correct_trial(&trial, &ctx.model, &ctx.limits, &ctx.settings, variant, &control)?;
+    let correction = correct_trial(
+        &trial,
+        &ctx.model,
+        &ctx.limits,
+        &ctx.settings,
+        variant,
+        &control,
+    )?;
     progress.finish();
     if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }
     write_trial(&correction.corrected, &output, format)?;
-    let sidecar = build_sidecar(&args.input, &trial, &output, format, &ctx, &correction, in_format)?;
-    let sc_path = args.sidecar.clone().unwrap_or_else(|| sidecar_path(&output));
+    let sidecar = build_sidecar(
+        &args.input,
+        &trial,
+        &output,
+        format,
+        &ctx,
+        &correction,
+        in_format,
+    )?;
+    let sc_path = args
+        .sidecar
+        .clone()
+        .unwrap_or_else(|| sidecar_path(&output));
     atomic_write(&sc_path, sidecar.to_json().as_bytes())?;
     if !args.quiet {
         for s in &correction.skipped {

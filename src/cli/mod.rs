@@ -18,12 +18,18 @@ pub const EXIT_OK: i32 = 0;
 /// Exit code: failure while working.
 pub const EXIT_FAILURE: i32 = 1;
 /// Exit code: malformed input data.
+#[allow(dead_code)] // used once a command reads input files
 pub const EXIT_BAD_INPUT: i32 = 3;
 /// Exit code: the workbench needs a terminal.
+#[allow(dead_code)] // used by the workbench
 pub const EXIT_NO_TERMINAL: i32 = 4;
 
 #[derive(Debug, Parser)]
-#[command(name = "acmw", version, about = "Correct IMU joint angles with the Anatomical Constraint Method")]
+#[command(
+    name = "acmw",
+    version,
+    about = "Correct IMU joint angles with the Anatomical Constraint Method"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,

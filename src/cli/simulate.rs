@@ -1,11 +1,297 @@
-//! `acmw simulate`: write a simulated trial and its truth.
+//! `acmw simulate`: write a simulated trial and its truth beside it.
 
-use clap::Args;
+use acm_workbench::simulate::{
+    self, HeadingDrift, ImuMisalignment, KneeAxis, KneeImu, Misalignment, SimConfig,
+    RANDOM_MISALIGNMENT_DEG,
+};
+use acm_workbench::truth::{self, Truth};
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use std::path::{Path, PathBuf};
+
+/// Exit code of a configuration that cannot be simulated (a usage error).
+const EXIT_USAGE: i32 = 2;
 
 #[derive(Debug, Args)]
-pub struct SimulateArgs {}
+pub struct SimulateArgs {
+    #[command(subcommand)]
+    pub what: What,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum What {
+    /// Thesis 4.1 knee test: static thigh, calf flexing 15-75 deg at 5 cycles/min,
+    /// one IMU misaligned about X or Z (IMUs l_thigh and l_calf).
+    Knee(KneeArgs),
+    /// The 13 IMUs of infant13: crawling-like motion, random 5-30 deg misalignment
+    /// of every non-base IMU, optional heading drift, noise.
+    FullBody(FullBodyArgs),
+    /// A named configuration (knee_calf_z15, full_body_clean, full_body_drift);
+    /// the common options override it.
+    Preset(PresetArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct KneeArgs {
+    /// The misaligned IMU.
+    #[arg(long, value_enum, default_value = "calf")]
+    pub imu: KneeImu,
+    /// The sensor axis of the misalignment.
+    #[arg(long, value_enum, default_value = "z")]
+    pub axis: KneeAxis,
+    /// Misalignment angle, degrees.
+    #[arg(long, default_value_t = 15.0, allow_negative_numbers = true)]
+    pub angle: f64,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct FullBodyArgs {
+    /// Smallest and largest random misalignment angle, degrees.
+    #[arg(long, num_args = 2, value_names = ["MIN", "MAX"])]
+    pub misalign_range: Option<Vec<f64>>,
+    /// Misalign only the given IMUs instead, by a rotation vector in degrees in the
+    /// sensor frame, IMU:X:Y:Z (repeatable).
+    #[arg(long = "misalign", value_parser = parse_misalignment, allow_hyphen_values = true)]
+    pub misalign: Vec<ImuMisalignment>,
+    /// No misalignment at all.
+    #[arg(long, conflicts_with_all = ["misalign", "misalign_range"])]
+    pub aligned: bool,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct PresetArgs {
+    /// Preset name.
+    #[arg(value_parser = simulate::PRESETS)]
+    pub name: String,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct CommonArgs {
+    /// Trial length, seconds [default: 300, preset's for a preset].
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// Sampling rate, Hz [default: 50].
+    #[arg(long)]
+    pub rate: Option<f64>,
+    /// Random seed [default: 0].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// RMS orientation noise per sample, degrees [default: 0 for knee, 0.3 full body].
+    #[arg(long)]
+    pub noise: Option<f64>,
+    /// Heading drift IMU:START_S:RATE_DEG_S about the global vertical (repeatable).
+    #[arg(long, value_parser = parse_drift, allow_hyphen_values = true)]
+    pub drift: Vec<HeadingDrift>,
+    /// Output trial file (`.csv` or `.csv.gz`); the truth goes beside it.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+fn parse_drift(s: &str) -> Result<HeadingDrift, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let [imu, start, rate] = parts[..] else {
+        return Err(format!("expected IMU:START_S:RATE_DEG_S, found '{s}'"));
+    };
+    let num = |v: &str, what: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("{what} '{v}' is not a number"))
+    };
+    Ok(HeadingDrift {
+        imu: imu.trim().to_string(),
+        start_s: num(start, "start")?,
+        rate_deg_s: num(rate, "rate")?,
+    })
+}
+
+fn parse_misalignment(s: &str) -> Result<ImuMisalignment, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let [imu, x, y, z] = parts[..] else {
+        return Err(format!("expected IMU:X:Y:Z (degrees), found '{s}'"));
+    };
+    let num = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{v}' is not a number"))
+    };
+    Ok(ImuMisalignment {
+        imu: imu.trim().to_string(),
+        rotvec_deg: [num(x)?, num(y)?, num(z)?],
+    })
+}
+
+impl CommonArgs {
+    fn apply(&self, cfg: &mut SimConfig) {
+        if let Some(d) = self.duration {
+            cfg.duration_s = d;
+        }
+        if let Some(r) = self.rate {
+            cfg.rate_hz = r;
+        }
+        if let Some(s) = self.seed {
+            cfg.seed = s;
+        }
+        if let Some(n) = self.noise {
+            cfg.noise_deg = n;
+        }
+        if !self.drift.is_empty() {
+            cfg.drifts = self.drift.clone();
+        }
+    }
+}
 
 /// Runs `acmw simulate`.
-pub fn run(_args: SimulateArgs) -> anyhow::Result<i32> {
-    anyhow::bail!("not written yet")
+pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
+    let (mut cfg, common) = match args.what {
+        What::Knee(a) => (SimConfig::knee(a.imu, a.axis, a.angle), a.common),
+        What::FullBody(a) => {
+            let mut cfg = SimConfig::full_body(0);
+            cfg.misalignment = if a.aligned {
+                Misalignment::None
+            } else if !a.misalign.is_empty() {
+                Misalignment::Fixed { imus: a.misalign }
+            } else {
+                let r = a.misalign_range.unwrap_or(RANDOM_MISALIGNMENT_DEG.to_vec());
+                Misalignment::Random {
+                    min_deg: r[0],
+                    max_deg: r[1],
+                }
+            };
+            (cfg, a.common)
+        }
+        What::Preset(a) => (
+            simulate::preset(&a.name).context("unknown preset")?,
+            a.common,
+        ),
+    };
+    common.apply(&mut cfg);
+    let out = &common.output;
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if !(name.ends_with(".csv") || name.ends_with(".csv.gz")) || truth::is_truth_file(out) {
+        eprintln!(
+            "acmw: the output must be a trial file ending in .csv or .csv.gz (not a .truth file), found '{}'",
+            out.display()
+        );
+        return Ok(EXIT_USAGE);
+    }
+    let sim = match simulate::simulate(&cfg) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("acmw: {e}");
+            return Ok(EXIT_USAGE);
+        }
+    };
+    let mut trial = sim.trial;
+    trial.name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let (truth_csv, truth_json) = save(&trial, &sim.truth, out)?;
+
+    println!(
+        "wrote {}: {} IMUs, {} samples ({} s at {} Hz), seed {}, noise {} deg",
+        out.display(),
+        trial.imus.len(),
+        trial.len(),
+        cfg.duration_s,
+        cfg.rate_hz,
+        cfg.seed,
+        cfg.noise_deg
+    );
+    let misaligned: Vec<String> = sim
+        .truth
+        .meta
+        .misalignments
+        .iter()
+        .filter_map(|(imu, q)| {
+            let a =
+                acm_workbench::rotation::angle_deg(&acm_workbench::rotation::quat_from_wxyz(*q));
+            (a > 1e-9).then(|| format!("{imu} {a:.1}"))
+        })
+        .collect();
+    if misaligned.is_empty() {
+        println!("  misalignment: none");
+    } else {
+        println!("  misalignment (deg): {}", misaligned.join(", "));
+    }
+    for d in &cfg.drifts {
+        println!(
+            "  heading drift: {} from {} s at {} deg/s",
+            d.imu, d.start_s, d.rate_deg_s
+        );
+    }
+    println!("wrote {} (segment orientations)", truth_csv.display());
+    println!(
+        "wrote {} (configuration, misalignments, drifts)",
+        truth_json.display()
+    );
+    Ok(0)
+}
+
+/// Writes the trial and its truth files; returns the truth paths.
+fn save(
+    trial: &acm_workbench::trial::Trial,
+    truth: &Truth,
+    out: &Path,
+) -> anyhow::Result<(PathBuf, PathBuf)> {
+    acm_workbench::trial::write_trial(trial, out, acm_workbench::trial::TrialFormat::QuatCsv)?;
+    Ok(truth.save_beside(out)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn simulate_cli_parses_drift_and_misalignment() {
+        let d = parse_drift("l_calf:60:0.05").unwrap();
+        assert_eq!(
+            (d.imu.as_str(), d.start_s, d.rate_deg_s),
+            ("l_calf", 60.0, 0.05)
+        );
+        assert_eq!(parse_drift("r_foot:0:-0.1").unwrap().rate_deg_s, -0.1);
+        assert!(parse_drift("l_calf:60").is_err());
+        assert!(parse_drift("l_calf:x:1").unwrap_err().contains("start"));
+        let m = parse_misalignment("head:0:-20:5").unwrap();
+        assert_eq!((m.imu.as_str(), m.rotvec_deg), ("head", [0.0, -20.0, 5.0]));
+        assert!(parse_misalignment("head:1:2").is_err());
+    }
+
+    #[test]
+    fn simulate_cli_writes_trial_and_truth() {
+        use clap::Parser;
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("k.csv.gz");
+        let cli = crate::cli::Cli::try_parse_from([
+            "acmw",
+            "simulate",
+            "knee",
+            "--imu",
+            "calf",
+            "--axis",
+            "z",
+            "--angle",
+            "15",
+            "--duration",
+            "2",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .unwrap();
+        assert_eq!(crate::cli::run(cli), 0);
+        assert!(out.exists());
+        assert!(dir.path().join("k.truth.csv.gz").exists());
+        let json = std::fs::read_to_string(dir.path().join("k.truth.json")).unwrap();
+        let meta = acm_workbench::truth::TruthMeta::from_json(&json, "k.truth.json").unwrap();
+        assert_eq!(meta.config.duration_s, 2.0);
+    }
 }
