@@ -4,9 +4,10 @@
 
 use crate::acm::{Correction, JointResult, SkippedJoint, Variant};
 use crate::limits::{LimitTable, Settings};
-use crate::metrics::JointFigures;
+use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
-use crate::trial::TrialFormat;
+use crate::save::atomic_write;
+use crate::trial::{write_trial, Trial, TrialFormat};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -139,5 +140,125 @@ impl Sidecar {
     /// The variant's name (for display).
     pub fn variant_name(&self) -> &'static str {
         Variant::name(self.variant)
+    }
+}
+
+/// The default output path of a corrected trial:
+/// `corrected/<stem>.<variant>.<ext>[.gz]` in the input's folder.
+pub fn default_output(input: &Path, variant: Variant, format: TrialFormat, gzip: bool) -> PathBuf {
+    let name = input.file_name().unwrap_or_default().to_string_lossy();
+    let lower = name.to_ascii_lowercase();
+    let mut stem_len = name.len();
+    for ext in [".gz", ".csv", ".sto"] {
+        if lower[..stem_len].ends_with(ext) {
+            stem_len -= ext.len();
+        }
+    }
+    let stem = &name[..stem_len];
+    let ext = match format {
+        TrialFormat::Sto => "sto",
+        _ => "csv",
+    };
+    let gz = if gzip { ".gz" } else { "" };
+    input
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join("corrected")
+        .join(format!("{stem}.{variant}.{ext}{gz}"))
+}
+
+/// What to save: a finished correction of the trial read from `input`.
+pub struct SaveRequest<'a> {
+    /// The file the raw trial was read from.
+    pub input: &'a Path,
+    pub input_format: TrialFormat,
+    /// The raw trial as read.
+    pub trial: &'a Trial,
+    pub correction: &'a Correction,
+    pub model: &'a Model,
+    pub limits: &'a LimitTable,
+    /// Where the table came from (a path or `<built-in NAME>`).
+    pub limits_source: &'a str,
+    /// The corrected trial's path and format.
+    pub output: &'a Path,
+    pub output_format: TrialFormat,
+    /// The sidecar's path; `None` for [`sidecar_path`] of the output.
+    pub sidecar: Option<&'a Path>,
+}
+
+impl SaveRequest<'_> {
+    /// The sidecar record of this correction (reads the input file for its hash).
+    pub fn sidecar(&self) -> anyhow::Result<Sidecar> {
+        let bytes = std::fs::read(self.input)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", self.input.display()))?;
+        let input = InputRecord {
+            file: self.input.display().to_string(),
+            format: self.input_format,
+            sha256: sha256_hex(&bytes),
+            samples: self.trial.len(),
+            imus: self.trial.imus.iter().map(|i| i.name.clone()).collect(),
+        };
+        let figures = FiguresRecord {
+            before: trial_figures(self.trial, None, None, self.model, self.limits),
+            after: trial_figures(
+                &self.correction.corrected,
+                Some(self.trial),
+                None,
+                self.model,
+                self.limits,
+            ),
+        };
+        let mut s = Sidecar::new(
+            input,
+            self.output,
+            self.output_format,
+            self.model,
+            self.limits,
+            self.limits_source,
+            self.correction,
+            figures,
+        );
+        s.warnings = self.trial.warnings.clone();
+        Ok(s)
+    }
+
+    /// Writes the corrected trial and its sidecar, each atomically (previous
+    /// files are kept as `.bak`). Returns the sidecar's path.
+    pub fn save(&self) -> anyhow::Result<PathBuf> {
+        if let Some(dir) = self.output.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| anyhow::anyhow!("{}: cannot create folder: {e}", dir.display()))?;
+        }
+        let sidecar = self.sidecar()?;
+        write_trial(&self.correction.corrected, self.output, self.output_format)?;
+        let path = self
+            .sidecar
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| sidecar_path(self.output));
+        atomic_write(&path, sidecar.to_json().as_bytes())
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+        Ok(path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_output_names() {
+        let p = default_output(
+            Path::new("d/walk.CSV.gz"),
+            Variant::Drift,
+            TrialFormat::QuatCsv,
+            true,
+        );
+        assert_eq!(p, Path::new("d/corrected/walk.drift.csv.gz"));
+        let p = default_output(Path::new("w.sto"), Variant::Basic, TrialFormat::Sto, false);
+        assert_eq!(p, Path::new("corrected/w.basic.sto"));
+        assert_eq!(
+            sidecar_path(Path::new("a/b.csv")),
+            Path::new("a/b.csv.acmw.json")
+        );
     }
 }

@@ -2,12 +2,10 @@
 
 use super::common::{load_context, Context, EngineArgs, Progress};
 use acm_workbench::acm::{correct_trial, RunControl, Variant};
-use acm_workbench::metrics::trial_figures;
-use acm_workbench::save::atomic_write;
-use acm_workbench::sidecar::{sha256_hex, sidecar_path, FiguresRecord, InputRecord, Sidecar};
-use acm_workbench::trial::{detect_format, read_trial, write_trial, Trial, TrialFormat};
+use acm_workbench::sidecar::{default_output, SaveRequest, Sidecar};
+use acm_workbench::trial::{detect_format, read_trial, TrialFormat};
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct CorrectArgs {
@@ -34,26 +32,6 @@ pub struct CorrectArgs {
     /// No progress or summary output.
     #[arg(short, long)]
     pub quiet: bool,
-}
-
-/// The default output path: `corrected/<stem>.<variant>.<ext>[.gz]` beside the input.
-pub fn default_output(input: &Path, variant: Variant, format: TrialFormat, gzip: bool) -> PathBuf {
-    let name = input.file_name().unwrap_or_default().to_string_lossy();
-    let stem = name
-        .trim_end_matches(".gz")
-        .trim_end_matches(".csv")
-        .trim_end_matches(".sto")
-        .to_string();
-    let ext = match format {
-        TrialFormat::Sto => "sto",
-        _ => "csv",
-    };
-    let gz = if gzip { ".gz" } else { "" };
-    input
-        .parent()
-        .unwrap_or(Path::new("."))
-        .join("corrected")
-        .join(format!("{stem}.{variant}.{ext}{gz}"))
 }
 
 /// Runs `acmw correct`.
@@ -104,24 +82,19 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         &control,
     )?;
     progress.finish();
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
+    let sc_path = SaveRequest {
+        input: &args.input,
+        input_format: in_format,
+        trial: &trial,
+        correction: &correction,
+        model: &ctx.model,
+        limits: &ctx.limits,
+        limits_source: &ctx.limits_source,
+        output: &output,
+        output_format: format,
+        sidecar: args.sidecar.as_deref(),
     }
-    write_trial(&correction.corrected, &output, format)?;
-    let sidecar = build_sidecar(
-        &args.input,
-        &trial,
-        &output,
-        format,
-        &ctx,
-        &correction,
-        in_format,
-    )?;
-    let sc_path = args
-        .sidecar
-        .clone()
-        .unwrap_or_else(|| sidecar_path(&output));
-    atomic_write(&sc_path, sidecar.to_json().as_bytes())?;
+    .save()?;
     if !args.quiet {
         for s in &correction.skipped {
             eprintln!("skipped {}: {}", s.joint, s.reason);
@@ -135,45 +108,4 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         );
     }
     Ok(0)
-}
-
-fn build_sidecar(
-    input: &Path,
-    trial: &Trial,
-    output: &Path,
-    format: TrialFormat,
-    ctx: &Context,
-    correction: &acm_workbench::acm::Correction,
-    in_format: TrialFormat,
-) -> anyhow::Result<Sidecar> {
-    let bytes = std::fs::read(input)?;
-    let record = InputRecord {
-        file: input.display().to_string(),
-        format: in_format,
-        sha256: sha256_hex(&bytes),
-        samples: trial.len(),
-        imus: trial.imus.iter().map(|i| i.name.clone()).collect(),
-    };
-    let figures = FiguresRecord {
-        before: trial_figures(trial, None, None, &ctx.model, &ctx.limits),
-        after: trial_figures(
-            &correction.corrected,
-            Some(trial),
-            None,
-            &ctx.model,
-            &ctx.limits,
-        ),
-    };
-    let mut s = Sidecar::new(
-        record,
-        output,
-        format,
-        &ctx.model,
-        &ctx.limits,
-        &ctx.limits_source,
-        correction,
-        figures,
-    );
-    s.warnings = trial.warnings.clone();
-    Ok(s)
 }
