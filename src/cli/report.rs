@@ -4,6 +4,7 @@ use super::common::{load_context, EngineArgs, Progress};
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::report::{format_text, ReportInput};
 use acm_workbench::trial::read_trial;
+use acm_workbench::truth::load_truth_beside;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -28,6 +29,15 @@ pub struct ReportArgs {
 pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     let ctx = load_context(&args.engine, Some(&args.input))?;
     let trial = read_trial(&args.input, &ctx.model)?;
+    let truth = match load_truth_beside(&args.input, &ctx.model) {
+        Some(t) => {
+            let t = t?;
+            t.check_against(&trial)
+                .map_err(|e| anyhow::anyhow!("{}: truth does not fit the trial: {e}", args.input.display()))?;
+            Some(t)
+        }
+        None => None,
+    };
     let variants = if args.variant.is_empty() {
         Variant::ALL.to_vec()
     } else {
@@ -45,7 +55,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         limits: &ctx.limits,
         limits_source: &ctx.limits_source,
         settings: &ctx.settings,
-        truth: None,
+        truth: truth.as_ref().map(|t| &t.segments),
     };
     let r = input.run(&variants, &control)?;
     progress.finish();
