@@ -182,10 +182,13 @@ pub fn format_text(r: &TrialReport) -> String {
     for w in &r.warnings {
         let _ = writeln!(out, "warning: {w}");
     }
-    for v in &r.variants {
-        for s in &v.skipped {
-            let _ = writeln!(out, "{}: skipped {}: {}", v.variant, s.joint, s.reason);
-        }
+    if let Some(v) = r.variants.first().filter(|v| !v.skipped.is_empty()) {
+        let list: Vec<String> = v
+            .skipped
+            .iter()
+            .map(|s| format!("{} ({})", s.joint, s.reason))
+            .collect();
+        let _ = writeln!(out, "skipped joints: {}", list.join("; "));
     }
     table(
         &mut out,

@@ -187,13 +187,11 @@ pub fn load_truth_beside(trial_path: &Path, model: &Model) -> Option<Result<Trut
 
 fn load(csv: &Path, json: &Path, model: &Model) -> Result<Truth, TrialError> {
     let json_name = json.display().to_string();
-    for p in [csv, json] {
-        if !p.exists() {
-            return Err(TrialError::file(
-                p.display().to_string(),
-                "missing: a truth needs both the .truth.csv.gz and the .truth.json file",
-            ));
-        }
+    if !json.exists() {
+        return Err(TrialError::file(
+            &json_name,
+            "missing: a truth needs its .truth.json file (the .truth.csv.gz is optional)",
+        ));
     }
     let text = std::fs::read_to_string(json)
         .map_err(|e| TrialError::file(&json_name, format!("cannot read: {e}")))?;
@@ -206,6 +204,15 @@ fn load(csv: &Path, json: &Path, model: &Model) -> Result<Truth, TrialError> {
                 meta.model, model.name
             ),
         ));
+    }
+    if !csv.exists() {
+        // Only the configuration is stored: simulate it again (deterministic).
+        let sim = crate::simulate::simulate(&meta.config)
+            .map_err(|e| TrialError::file(&json_name, e.to_string()))?;
+        return Ok(Truth {
+            segments: sim.truth.segments,
+            meta,
+        });
     }
     let segments = trial::read_trial(csv, model)?;
     Ok(Truth { segments, meta })

@@ -91,6 +91,14 @@ pub struct CommonArgs {
     /// Output trial file (`.csv` or `.csv.gz`); the truth goes beside it.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Round the written quaternion components to this many decimals, as a
+    /// sensor's output resolution (6 decimals is under 1e-4 deg) [default: exact].
+    #[arg(long)]
+    pub decimals: Option<u32>,
+    /// Write only NAME.truth.json; the truth's segment orientations are then
+    /// simulated again from it when needed (deterministic), which keeps folders small.
+    #[arg(long)]
+    pub truth_json_only: bool,
 }
 
 fn parse_drift(s: &str) -> Result<HeadingDrift, String> {
@@ -195,7 +203,11 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (truth_csv, truth_json) = save(&trial, &sim.truth, out)?;
+    let trial = match common.decimals {
+        Some(d) => simulate::round_orientations(&trial, d),
+        None => trial,
+    };
+    let (truth_csv, truth_json) = save(&trial, &sim.truth, out, common.truth_json_only)?;
 
     println!(
         "wrote {}: {} IMUs, {} samples ({} s at {} Hz), seed {}, noise {} deg",
@@ -242,8 +254,14 @@ fn save(
     trial: &acm_workbench::trial::Trial,
     truth: &Truth,
     out: &Path,
+    json_only: bool,
 ) -> anyhow::Result<(PathBuf, PathBuf)> {
     acm_workbench::trial::write_trial(trial, out, acm_workbench::trial::TrialFormat::QuatCsv)?;
+    if json_only {
+        let (csv, json) = truth::truth_paths(out);
+        truth.meta.save(&json)?;
+        return Ok((csv, json));
+    }
     Ok(truth.save_beside(out)?)
 }
 

@@ -527,3 +527,24 @@ fn misalignments(
     }
     out
 }
+
+/// The trial with every quaternion component rounded to `decimals` decimals,
+/// as a sensor with that output resolution writes it. The components are kept
+/// as rounded (their norm is 1 within about `10^-decimals`); readers renormalise.
+pub fn round_orientations(trial: &Trial, decimals: u32) -> Trial {
+    let scale = 10f64.powi(decimals as i32);
+    let round = |v: f64| (v * scale).round() / scale;
+    let mut out = trial.clone();
+    for imu in &mut out.imus {
+        for q in &mut imu.orientation {
+            let c = crate::rotation::canonical(q);
+            *q = Quat::new_unchecked(nalgebra::Quaternion::new(
+                round(c.w),
+                round(c.i),
+                round(c.j),
+                round(c.k),
+            ));
+        }
+    }
+    out
+}
