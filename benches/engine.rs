@@ -90,7 +90,9 @@ fn benches(c: &mut Criterion) {
 
     let mut g = c.benchmark_group("correct");
     g.sample_size(10).measurement_time(Duration::from_secs(20));
-    g.bench_function("drift-centroid 5 min", |b| b.iter(|| run(&five, Variant::DriftCentroid)));
+    g.bench_function("drift-centroid 5 min", |b| {
+        b.iter(|| run(&five, Variant::DriftCentroid))
+    });
     g.bench_function("drift 5 min", |b| b.iter(|| run(&five, Variant::Drift)));
     g.bench_function("basic 5 min", |b| b.iter(|| run(&five, Variant::Basic)));
     g.bench_function("drift-centroid 30 min", |b| {
@@ -103,7 +105,11 @@ fn benches(c: &mut Criterion) {
     let lim = table.joint_limits("l_hip", "hip", true).unwrap();
     let base = &five.imu("base").unwrap().orientation;
     let thigh = &five.imu("l_thigh").unwrap().orientation;
-    let measured: Vec<Quat> = base.iter().zip(thigh).map(|(p, c)| p.inverse() * c).collect();
+    let measured: Vec<Quat> = base
+        .iter()
+        .zip(thigh)
+        .map(|(p, c)| p.inverse() * c)
+        .collect();
     let windows = layout(&five.time_s, 60.0, 30.0);
     g.bench_function("one joint drift-centroid 5 min", |b| {
         b.iter(|| correct_joint(&five.time_s, &measured, &windows, &lim, 0.05))

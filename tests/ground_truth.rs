@@ -57,7 +57,10 @@ fn knee_calf_misaligned_about_z_is_restored() {
     // After: inside the limits, flexion within 2 deg of the true 15..75.
     assert!(mean_excursion(&cor) <= 0.05, "{}", mean_excursion(&cor));
     let (lo, hi) = range(cor.iter().map(|a| a[1]));
-    assert!((lo - 15.0).abs() < 2.0 && (hi - 75.0).abs() < 2.0, "{lo}..{hi}");
+    assert!(
+        (lo - 15.0).abs() < 2.0 && (hi - 75.0).abs() < 2.0,
+        "{lo}..{hi}"
+    );
 }
 
 #[test]
@@ -65,10 +68,16 @@ fn knee_calf_misaligned_about_x_is_left_inside_the_band() {
     let (sim, c) = knee_case(KneeImu::Calf, KneeAxis::X);
     let raw = knee_angles(&sim.trial);
     let cor = knee_angles(&c.corrected);
-    assert!(raw.iter().all(|a| (a[0] - 15.0).abs() < 1e-6), "raw rotation offset is 15 deg");
+    assert!(
+        raw.iter().all(|a| (a[0] - 15.0).abs() < 1e-6),
+        "raw rotation offset is 15 deg"
+    );
     assert!(mean_excursion(&cor) <= 0.05);
     let (lo, hi) = range(cor.iter().map(|a| a[1]));
-    assert!((lo - 15.0).abs() < 2.0 && (hi - 75.0).abs() < 2.0, "{lo}..{hi}");
+    assert!(
+        (lo - 15.0).abs() < 2.0 && (hi - 75.0).abs() < 2.0,
+        "{lo}..{hi}"
+    );
     // The source's finding: lambda1 makes the cheapest fix the one that just
     // brings the angles inside, so the rotation is left anywhere inside the
     // +/-5 deg band (here it spans most of it with flexion), not at the true 0,
@@ -76,7 +85,10 @@ fn knee_calf_misaligned_about_x_is_left_inside_the_band() {
     let (xlo, xhi) = range(cor.iter().map(|a| a[0]));
     let xmean = cor.iter().map(|a| a[0]).sum::<f64>() / cor.len() as f64;
     assert!(xlo > -5.05 && xhi < 5.05, "rotation {xlo}..{xhi}");
-    assert!(xhi - xlo > 3.0 && xmean > 2.0, "rotation {xlo}..{xhi}, mean {xmean}");
+    assert!(
+        xhi - xlo > 3.0 && xmean > 2.0,
+        "rotation {xlo}..{xhi}, mean {xmean}"
+    );
     let angle = c.joints[0].windows[0].angle_deg;
     assert!(angle < 14.0, "correction {angle} deg of the true 15");
     eprintln!("calf 15 deg about X: rotation left at {xlo:.2}..{xhi:.2} (mean {xmean:.2}), correction {angle:.2} deg");
@@ -114,7 +126,13 @@ fn full_body_rows() -> Vec<JointRow> {
     let sim = simulate(&preset("full_body_drift").unwrap()).unwrap();
     let model = Model::infant13();
     let table = LimitTable::default_table();
-    let drifting: Vec<String> = sim.truth.meta.drifts.iter().map(|d| d.imu.clone()).collect();
+    let drifting: Vec<String> = sim
+        .truth
+        .meta
+        .drifts
+        .iter()
+        .map(|d| d.imu.clone())
+        .collect();
     assert!(sim.truth.meta.drifts.iter().all(|d| d.rate_deg_s <= 0.1));
     let runs: Vec<Correction> = Variant::ALL.iter().map(|&v| run(&sim.trial, v)).collect();
     model
@@ -173,12 +191,21 @@ fn full_body_with_drift_against_truth() {
             r.rms[0],
             r.rms[1],
             r.rms[2],
-            if r.drifting_imu { "  (drifting IMU)" } else { "" }
+            if r.drifting_imu {
+                "  (drifting IMU)"
+            } else {
+                ""
+            }
         );
     }
     let mut checked = 0;
     for r in rows.iter().filter(|r| r.excess > 1.0) {
-        assert!(r.removed[1] >= 0.7, "{}: drift removed {:.0}%", r.joint, 100.0 * r.removed[1]);
+        assert!(
+            r.removed[1] >= 0.7,
+            "{}: drift removed {:.0}%",
+            r.joint,
+            100.0 * r.removed[1]
+        );
         checked += 1;
     }
     assert!(checked >= 5, "the preset must exercise the rule");
@@ -186,5 +213,8 @@ fn full_body_with_drift_against_truth() {
     assert_eq!(drifting.len(), 4);
     let basic = median(drifting.iter().map(|r| r.rms[0]).collect());
     let drift = median(drifting.iter().map(|r| r.rms[1]).collect());
-    assert!(drift <= basic, "median RMS over drifting joints: drift {drift} > basic {basic}");
+    assert!(
+        drift <= basic,
+        "median RMS over drifting joints: drift {drift} > basic {basic}"
+    );
 }

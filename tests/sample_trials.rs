@@ -12,12 +12,18 @@ use std::path::Path;
 fn sample_trials_match_their_truth() {
     let model = Model::infant13();
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_trials");
-    let names = ["knee_calf_z15.csv.gz", "full_body_clean.csv.gz", "full_body_drift.csv.gz"];
+    let names = [
+        "knee_calf_z15.csv.gz",
+        "full_body_clean.csv.gz",
+        "full_body_drift.csv.gz",
+    ];
     for name in names {
         let path = dir.join(name);
         let trial = read_trial(&path, &model).unwrap();
         assert!(trial.warnings.is_empty(), "{name}: {:?}", trial.warnings);
-        let truth = load_truth_beside(&path, &model).expect("truth beside").unwrap();
+        let truth = load_truth_beside(&path, &model)
+            .expect("truth beside")
+            .unwrap();
         truth.check_against(&trial).unwrap();
         // The file is the simulator's output rounded to 6 decimals.
         let again = simulate(&truth.meta.config).unwrap().trial;
@@ -29,7 +35,11 @@ fn sample_trials_match_their_truth() {
                 .zip(sim)
                 .map(|(a, b)| angle_between_deg(a, b))
                 .fold(0.0, f64::max);
-            assert!(worst < 1e-3, "{name} {}: {worst} deg from the simulator", imu.name);
+            assert!(
+                worst < 1e-3,
+                "{name} {}: {worst} deg from the simulator",
+                imu.name
+            );
         }
     }
 }

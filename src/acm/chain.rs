@@ -128,7 +128,7 @@ fn run(
     for depth in 0..=max_depth {
         let level: Vec<&(usize, JointLimits)> =
             todo.iter().filter(|(k, _)| depths[*k] == depth).collect();
-        let solved: Vec<(usize, JointResult, Vec<Quat>)> = level
+        let solved: Vec<(usize, JointResult, Applied)> = level
             .par_iter()
             .map(|(k, lim)| {
                 let joint = &model.joints[*k];
@@ -136,8 +136,8 @@ fn run(
                 if let Some((prev, redo)) = reuse {
                     if !redo.contains(k) {
                         if let Some(r) = prev.joint(&joint.name) {
-                            let series = reuse_series(trial, prev, &joint.distal);
-                            return Ok((*k, r.clone(), series));
+                            let kept = prev.corrected.imu(&joint.distal).expect("present");
+                            return Ok((*k, r.clone(), Applied::Kept(kept.orientation.clone())));
                         }
                     }
                 }
@@ -171,14 +171,19 @@ fn run(
                     parent_corrected,
                     windows: sol.windows,
                 };
-                Ok((*k, result, sol.series))
+                Ok((*k, result, Applied::Series(sol.series)))
             })
             .collect::<Result<_, Cancelled>>()?;
-        for (k, result, series) in solved {
+        for (k, result, applied) in solved {
             let distal = &model.joints[k].distal;
             let imu = corrected.imu_mut(distal).expect("present");
-            for (q, c) in imu.orientation.iter_mut().zip(&series) {
-                *q = Quat::new_normalize((*q * c).into_inner());
+            match applied {
+                Applied::Series(series) => {
+                    for (q, c) in imu.orientation.iter_mut().zip(&series) {
+                        *q = Quat::new_normalize((*q * c).into_inner());
+                    }
+                }
+                Applied::Kept(orientation) => imu.orientation = orientation,
             }
             results.insert(k, result);
         }
@@ -198,11 +203,12 @@ fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &s
     results.keys().any(|&k| model.joints[k].distal == imu)
 }
 
-/// The per-sample correction a previous run applied to `imu`: `raw^-1 * corrected`.
-fn reuse_series(trial: &Trial, prev: &Correction, imu: &str) -> Vec<Quat> {
-    let raw = &trial.imu(imu).expect("present").orientation;
-    let cor = &prev.corrected.imu(imu).expect("present").orientation;
-    raw.iter().zip(cor).map(|(r, c)| r.inverse() * c).collect()
+/// What a joint's run gives its distal IMU.
+enum Applied {
+    /// A fresh per-sample correction `C(t)`, to apply as `G_R_dist * C(t)`.
+    Series(Vec<Quat>),
+    /// The corrected orientations of an earlier run, kept as they were.
+    Kept(Vec<Quat>),
 }
 
 /// Solves one joint: the measured joint rotations `Rm_i` (parent' to child), per sample.
@@ -307,4 +313,162 @@ fn solve_windows(
         series: correction_series(time_s, &centres, &qs),
         windows: solutions,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulate::{preset, simulate};
+
+    fn fixture() -> (Trial, Model, LimitTable) {
+        let mut cfg = preset("full_body_clean").unwrap();
+        cfg.duration_s = 70.0;
+        (
+            simulate(&cfg).unwrap().trial,
+            Model::infant13(),
+            LimitTable::default_table(),
+        )
+    }
+
+    fn run_with(trial: &Trial, model: &Model, table: &LimitTable, threads: usize) -> Correction {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                correct_trial(
+                    trial,
+                    model,
+                    table,
+                    &Settings::default(),
+                    Variant::DriftCentroid,
+                    &RunControl::default(),
+                )
+                .unwrap()
+            })
+    }
+
+    #[test]
+    fn children_are_measured_against_the_corrected_parent() {
+        let (trial, model, table) = fixture();
+        let run = run_with(&trial, &model, &table, 2);
+        let order: Vec<&str> = run.joints.iter().map(|j| j.joint.as_str()).collect();
+        let model_order: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+        assert_eq!(order, model_order);
+        let knee = model.joint("l_knee").unwrap();
+        let thigh = &run.corrected.imu("l_thigh").unwrap().orientation;
+        let calf = &trial.imu("l_calf").unwrap().orientation;
+        let measured: Vec<Quat> = thigh
+            .iter()
+            .zip(calf)
+            .map(|(p, c)| p.inverse() * c)
+            .collect();
+        let lim = table.joint_limits(&knee.name, &knee.kind, true).unwrap();
+        let windows = layout(&trial.time_s, 60.0, 30.0);
+        let alone = correct_joint(&trial.time_s, &measured, &windows, &lim, 0.05);
+        assert_eq!(alone.windows, run.joint("l_knee").unwrap().windows);
+        assert!(run.joint("l_knee").unwrap().parent_corrected);
+        assert!(!run.joint("l_hip").unwrap().parent_corrected);
+        // G_R_dist' = G_R_dist * C(t)
+        let cal = &run.corrected.imu("l_calf").unwrap().orientation;
+        for i in [0, 1234, trial.len() - 1] {
+            let expect = calf[i] * alone.series[i];
+            assert!(crate::rotation::angle_between_deg(&cal[i], &expect) < 1e-9);
+        }
+        // The base is never corrected.
+        assert!(run.corrected.imu("base") == trial.imu("base"));
+    }
+
+    #[test]
+    fn output_does_not_depend_on_thread_count() {
+        let (trial, model, table) = fixture();
+        let one = run_with(&trial, &model, &table, 1);
+        let two = run_with(&trial, &model, &table, 2);
+        let three = run_with(&trial, &model, &table, 3);
+        assert!(one == two, "1 vs 2 threads");
+        assert!(one == three, "1 vs 3 threads");
+    }
+
+    #[test]
+    fn recorrect_redoes_a_joint_and_its_descendants_only() {
+        let (trial, model, mut table) = fixture();
+        let settings = Settings::default();
+        let full = run_with(&trial, &model, &table, 2);
+        let same = recorrect(
+            &trial,
+            &model,
+            &table,
+            &settings,
+            &full,
+            &["l_knee"],
+            &RunControl::default(),
+        )
+        .unwrap();
+        assert!(same == full, "recorrect without a change");
+        // Narrow the knee's flexion range: knee and ankle change, nothing else.
+        let l_knee = crate::limits::LimitRow {
+            joint: "l_knee".into(),
+            axis: 1,
+            movement: "flexion/extension".into(),
+            lower_deg: 20.0,
+            upper_deg: 60.0,
+            centroid_deg: None,
+            lambda2: 0.0,
+        };
+        for axis in [0, 2] {
+            let mut r = table.row("knee", "knee", axis).unwrap().clone();
+            r.joint = "l_knee".into();
+            table.rows.push(r);
+        }
+        table.rows.push(l_knee);
+        let edited = recorrect(
+            &trial,
+            &model,
+            &table,
+            &settings,
+            &full,
+            &["l_knee"],
+            &RunControl::default(),
+        )
+        .unwrap();
+        for j in &model.joints {
+            let changed = edited.joint(&j.name) != full.joint(&j.name);
+            assert_eq!(
+                changed,
+                ["l_knee", "l_ankle"].contains(&j.name.as_str()),
+                "{}",
+                j.name
+            );
+        }
+        assert!(
+            edited == run_with(&trial, &model, &table, 2),
+            "recorrect vs full run"
+        );
+    }
+
+    #[test]
+    fn missing_imus_skip_their_joints_and_cancel_stops() {
+        let (mut trial, model, table) = fixture();
+        trial
+            .imus
+            .retain(|s| s.name != "head" && s.name != "l_thigh");
+        let run = run_with(&trial, &model, &table, 2);
+        let skipped: Vec<&str> = run.skipped.iter().map(|s| s.joint.as_str()).collect();
+        assert_eq!(skipped, ["neck", "l_hip", "l_knee"]);
+        assert!(run.skipped[0].reason.contains("'head'"));
+        let cancel = std::sync::atomic::AtomicBool::new(true);
+        let control = RunControl {
+            cancel: Some(&cancel),
+            progress: None,
+        };
+        let r = correct_trial(
+            &trial,
+            &model,
+            &table,
+            &Settings::default(),
+            Variant::Drift,
+            &control,
+        );
+        assert!(matches!(r, Err(Cancelled)));
+    }
 }

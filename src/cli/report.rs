@@ -32,8 +32,12 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {
             let t = t?;
-            t.check_against(&trial)
-                .map_err(|e| anyhow::anyhow!("{}: truth does not fit the trial: {e}", args.input.display()))?;
+            t.check_against(&trial).map_err(|e| {
+                anyhow::anyhow!(
+                    "{}: truth does not fit the trial: {e}",
+                    args.input.display()
+                )
+            })?;
             Some(t)
         }
         None => None,

@@ -1,0 +1,142 @@
+//! The `acmw` command line: correct, reproduce from a sidecar, report, errors.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn acmw(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_acmw"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn simulated(dir: &Path) {
+    let out = acmw(
+        dir,
+        &[
+            "simulate",
+            "preset",
+            "full_body_clean",
+            "--duration",
+            "70",
+            "-o",
+            "t.csv",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn correct_then_reproduce_from_the_sidecar() {
+    let dir = tempfile::tempdir().unwrap();
+    simulated(dir.path());
+    let out = acmw(
+        dir.path(),
+        &["correct", "t.csv", "--variant", "drift", "--quiet"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let first = dir.path().join("corrected/t.drift.csv");
+    let sidecar = dir.path().join("corrected/t.drift.csv.acmw.json");
+    assert!(first.exists() && sidecar.exists());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&sidecar).unwrap()).unwrap();
+    assert_eq!(json["variant"], "drift");
+    assert_eq!(json["joints"].as_array().unwrap().len(), 12);
+    assert_eq!(json["joints"][0]["windows"].as_array().unwrap().len(), 2);
+    assert_eq!(json["limits"]["sha256"].as_str().unwrap().len(), 64);
+    let out = acmw(
+        dir.path(),
+        &[
+            "correct",
+            "t.csv",
+            "--from-sidecar",
+            "corrected/t.drift.csv.acmw.json",
+            "--threads",
+            "1",
+            "-o",
+            "again.csv",
+            "--quiet",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(&first).unwrap(),
+        std::fs::read(dir.path().join("again.csv")).unwrap()
+    );
+}
+
+#[test]
+fn report_json_and_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    simulated(dir.path());
+    let out = acmw(
+        dir.path(),
+        &["report", "t.csv", "--variant", "basic", "--json", "--quiet"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["truth"], true);
+    assert_eq!(r["variants"][0]["variant"], "basic");
+    let before = r["uncorrected"][0]["excursion"]["joint_mean_excursion_deg"]
+        .as_f64()
+        .unwrap();
+    let after = r["variants"][0]["joints"][0]["excursion"]["joint_mean_excursion_deg"]
+        .as_f64()
+        .unwrap();
+    assert!(after <= before);
+    assert!(r["variants"][0]["joints"][0]["truth"]["rms_error_deg"].is_array());
+    let text = acmw(dir.path(), &["report", "t.csv", "--variant", "basic"]);
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(text.contains("RMS error against truth"), "{text}");
+    assert!(text.contains("l_knee"));
+}
+
+#[test]
+fn malformed_input_names_file_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("bad.csv"),
+        "time,l_calf_qw,l_calf_qx,l_calf_qy,l_calf_qz\n0,1,0,0,0\n0.02,1,0,x,0\n",
+    )
+    .unwrap();
+    let out = acmw(dir.path(), &["correct", "bad.csv"]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.csv:3:4"), "{err}");
+    std::fs::create_dir(dir.path().join("joint_limits")).unwrap();
+    std::fs::write(
+        dir.path().join("joint_limits/settings.toml"),
+        "table = \"t.csv\"\nlambda1 = 0.05\nwindow_s = 60.0\nhop_s = 30.0\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("joint_limits/t.csv"),
+        "joint,axis,movement,lower_deg,upper_deg,centroid_deg,lambda2\nknee,Y,flexion,10,5,,0\n",
+    )
+    .unwrap();
+    simulated(dir.path());
+    let out = acmw(dir.path(), &["report", "t.csv"]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("t.csv:2:5") && err.contains("upper_deg > lower_deg"),
+        "{err}"
+    );
+}
