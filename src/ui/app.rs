@@ -1085,7 +1085,13 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::End => app.view.cursor_s = d,
         Action::Marker => app.view.braille = !app.view.braille,
         Action::Variant => next_variant(app),
-        Action::Compare => app.screen = Screen::Compare,
+        Action::Compare => {
+            app.compare_col = Variant::ALL
+                .iter()
+                .position(|v| *v == app.variant)
+                .unwrap_or(0);
+            app.screen = Screen::Compare;
+        }
         Action::Run => {
             if let Some(f) = app.open.clone() {
                 return app.run_effect(&f, None).into_iter().collect();

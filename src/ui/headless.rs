@@ -198,3 +198,26 @@ pub fn buffer_ansi(buf: &Buffer) -> String {
     }
     out
 }
+
+/// Writes a small fixed folder of trials into `dir` (created): `knee.csv`
+/// (knee_calf_z15, 60 s), `fb.csv.gz` (full_body_clean, 30 s), both with their
+/// truth beside, and `broken.csv` (not a trial). Snapshot tests, the `acmw
+/// render` test and demos use it.
+pub fn write_demo_folder(dir: &Path) -> Result<(), String> {
+    use crate::simulate::{preset, simulate};
+    use crate::trial::{write_trial, TrialFormat};
+    std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    for (name, preset_name, seconds) in [
+        ("knee.csv", "knee_calf_z15", 60.0),
+        ("fb.csv.gz", "full_body_clean", 30.0),
+    ] {
+        let mut cfg = preset(preset_name).ok_or("unknown preset")?;
+        cfg.duration_s = seconds;
+        let sim = simulate(&cfg).map_err(|e| e.to_string())?;
+        let out = dir.join(name);
+        write_trial(&sim.trial, &out, TrialFormat::QuatCsv).map_err(|e| e.to_string())?;
+        sim.truth.save_beside(&out).map_err(|e| e.to_string())?;
+    }
+    std::fs::write(dir.join("broken.csv"), "garbage,1,2\n").map_err(|e| e.to_string())?;
+    Ok(())
+}

@@ -124,25 +124,52 @@ fn popup(f: &mut Frame, theme: &Theme, area: Rect, title: &str, lines: Vec<Line>
 }
 
 fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
-    let mut lines = vec![];
-    let mut scope: Option<Scope> = None;
-    for (keys, text, s) in help_lines() {
-        if scope != Some(s) {
-            scope = Some(s);
-            lines.push(Line::from(Span::styled(s.title(), theme.header)));
+    let order = [
+        Scope::Everywhere,
+        Scope::Trials,
+        Scope::Trial,
+        Scope::Compare,
+        Scope::Limits,
+    ];
+    let mut items: Vec<Line> = vec![];
+    for scope in order {
+        let entries: Vec<_> = help_lines().into_iter().filter(|l| l.2 == scope).collect();
+        if entries.is_empty() {
+            continue;
         }
-        lines.push(Line::from(vec![
-            Span::styled(format!("  {keys:<11}"), theme.title),
-            Span::raw(text),
-        ]));
+        items.push(Line::from(Span::styled(scope.title(), theme.header)));
+        for (keys, text, _) in entries {
+            items.push(Line::from(vec![
+                Span::styled(format!(" {keys:<11}"), theme.title),
+                Span::raw(text),
+            ]));
+        }
     }
-    lines.push(Line::from(Span::styled(
-        "any key closes this help",
-        theme.dim,
-    )));
-    let h = (lines.len() as u16 + 2).min(body.height);
-    let area = centred(body, 60, h);
-    popup(f, theme, area, "Keys", lines);
+    // Two columns when the list is taller than the screen.
+    let inner_h = body.height.saturating_sub(3) as usize;
+    let two = items.len() > inner_h && body.width >= 78;
+    let w = if two { 78 } else { 50 };
+    let rows = if two {
+        items.len().div_ceil(2)
+    } else {
+        items.len()
+    };
+    let area = centred(body, w, rows as u16 + 2);
+    f.render_widget(Clear, area);
+    let block = Block::new()
+        .borders(Borders::ALL)
+        .title(Span::styled(" Keys (any key closes) ", theme.title));
+    let inner = block.inner(area);
+    f.render_widget(block, area);
+    if two {
+        let half = items.len().div_ceil(2);
+        let right = items.split_off(half);
+        let [a, b] = Layout::horizontal([Constraint::Ratio(1, 2); 2]).areas(inner);
+        f.render_widget(Paragraph::new(items), a);
+        f.render_widget(Paragraph::new(right), b);
+    } else {
+        f.render_widget(Paragraph::new(items), inner);
+    }
 }
 
 fn quit_confirm(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {

@@ -118,7 +118,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         let a = figures_of(after, &j.joint).map(|x| x.excursion.joint_mean_excursion_deg);
         lines.push(
             Line::from(joint_row(
-                &j.joint,
+                &format!("{}{}", if k == app.joint { ">" } else { " " }, j.joint),
                 Some(j.excursion.joint_mean_excursion_deg),
                 a,
                 iw,
