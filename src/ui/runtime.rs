@@ -121,8 +121,21 @@ fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
         None,
         move |r: DebounceEventResult| {
             let Ok(events) = r else { return };
+            // Reading a file (ours included) raises access events: only
+            // creations, content changes, renames and removals count.
             let paths: BTreeSet<PathBuf> = events
                 .iter()
+                .filter(|e| {
+                    use notify::event::{EventKind, ModifyKind};
+                    matches!(
+                        e.kind,
+                        EventKind::Create(_)
+                            | EventKind::Remove(_)
+                            | EventKind::Modify(
+                                ModifyKind::Data(_) | ModifyKind::Name(_) | ModifyKind::Any
+                            )
+                    )
+                })
                 .flat_map(|e| e.paths.iter().cloned())
                 .filter(|p| is_trial_file(p))
                 .collect();
@@ -156,10 +169,14 @@ fn watch_limits(dir: &Path, table: String, tx: Sender<Event>) -> Option<Watcher>
         None,
         move |r: DebounceEventResult| {
             let Ok(events) = r else { return };
-            let relevant = events.iter().flat_map(|e| e.paths.iter()).any(|p| {
-                p.file_name()
-                    .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
-            });
+            let relevant = events
+                .iter()
+                .filter(|e| !matches!(e.kind, notify::EventKind::Access(_)))
+                .flat_map(|e| e.paths.iter())
+                .any(|p| {
+                    p.file_name()
+                        .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
+                });
             if relevant {
                 if let Some((t, s)) = read_limits_on_disk(&d, &table) {
                     let _ = tx.send(Event::Msg(Msg::LimitsOnDisk(t, s)));
