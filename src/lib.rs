@@ -15,3 +15,4 @@ pub mod sidecar;
 pub mod simulate;
 pub mod trial;
 pub mod truth;
+pub mod ui;

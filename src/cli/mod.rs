@@ -10,6 +10,7 @@ use std::path::PathBuf;
 
 mod common;
 mod correct;
+mod render;
 mod report;
 mod simulate;
 
@@ -21,7 +22,6 @@ pub const EXIT_FAILURE: i32 = 1;
 #[allow(dead_code)] // used once a command reads input files
 pub const EXIT_BAD_INPUT: i32 = 3;
 /// Exit code: the workbench needs a terminal.
-#[allow(dead_code)] // used by the workbench
 pub const EXIT_NO_TERMINAL: i32 = 4;
 
 #[derive(Debug, Parser)]
@@ -35,6 +35,9 @@ pub struct Cli {
     pub command: Option<Command>,
     /// Folder of trials to open in the workbench (default: ./sample_trials).
     pub dir: Option<PathBuf>,
+    /// Colour theme of the workbench: dark, light or high-contrast (NO_COLOR is honoured).
+    #[arg(long, global = true, default_value = "dark")]
+    pub theme: String,
 }
 
 #[derive(Debug, Subcommand)]
@@ -45,6 +48,8 @@ pub enum Command {
     Report(report::ReportArgs),
     /// Simulate a trial with known misalignment and drift, and write its truth beside it.
     Simulate(simulate::SimulateArgs),
+    /// Print a workbench screen as text (trials, trial, compare, limits, help).
+    Render(render::RenderArgs),
 }
 
 /// Runs the parsed command line; returns the process exit code.
@@ -53,11 +58,8 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::Correct(a)) => correct::run(a),
         Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
-        None => {
-            use clap::CommandFactory;
-            let _ = Cli::command().print_help();
-            return EXIT_OK;
-        }
+        Some(Command::Render(a)) => render::run(a, &cli.theme),
+        None => workbench(cli.dir, &cli.theme),
     };
     match result {
         Ok(code) => code,
@@ -70,6 +72,26 @@ pub fn run(cli: Cli) -> i32 {
             }
         }
     }
+}
+
+/// Bare `acmw`: the terminal workbench, when there is a terminal.
+fn workbench(dir: Option<PathBuf>, theme: &str) -> anyhow::Result<i32> {
+    use std::io::IsTerminal;
+    if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
+        eprintln!(
+            "acmw: the workbench needs a terminal; see `acmw --help` for the headless commands (correct, report, render, simulate)"
+        );
+        return Ok(EXIT_NO_TERMINAL);
+    }
+    let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
+    let theme =
+        acm_workbench::ui::theme::Theme::builtin(theme, no_color).map_err(anyhow::Error::msg)?;
+    acm_workbench::ui::runtime::run(acm_workbench::ui::runtime::Options {
+        dir: dir.unwrap_or_else(|| PathBuf::from("sample_trials")),
+        limits_dir: common::default_limits_dir(),
+        theme,
+    })?;
+    Ok(EXIT_OK)
 }
 
 /// Whether an error comes from malformed input data (exit code 3).

@@ -1,0 +1,140 @@
+//! The compare screen: every variant side by side; choose one and save it.
+
+use super::app::App;
+use super::render::{fit, num};
+use super::theme::Theme;
+use crate::acm::Variant;
+use crate::metrics::JointFigures;
+use ratatui::layout::Rect;
+use ratatui::style::Style;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::Paragraph;
+use ratatui::Frame;
+
+fn rms(f: &JointFigures) -> Option<f64> {
+    f.truth
+        .as_ref()
+        .map(|t| (t.rms_error_deg.iter().map(|x| x * x).sum::<f64>() / 3.0).sqrt())
+}
+
+pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+    let Some(e) = app.open_entry() else {
+        f.render_widget(Paragraph::new("no trial open"), area);
+        return;
+    };
+    let truth = e.loaded().is_some_and(|l| l.truth.is_some());
+    let cw = if truth { 14 } else { 8 };
+    let nw = 12usize;
+    let mut lines = vec![Line::from(Span::styled(
+        if truth {
+            "joint mean excursion, deg  /  truth RMS error, deg (mean of X Y Z)"
+        } else {
+            "joint mean excursion, deg"
+        },
+        theme.dim,
+    ))];
+    let mut head = vec![Span::styled(
+        format!("  {}{:>w$}", fit("joint", nw), "raw", w = cw),
+        theme.header,
+    )];
+    for (k, v) in Variant::ALL.iter().enumerate() {
+        let mut name = v.name().to_string();
+        if e.chosen == Some(*v) {
+            name = format!("*{name}");
+        }
+        let style = if k == app.compare_col {
+            theme.selected.patch(theme.header)
+        } else {
+            theme.header
+        };
+        head.push(Span::raw(" "));
+        head.push(Span::styled(
+            format!("{name:>w$}", w = cw.max(15) - 1),
+            style,
+        ));
+    }
+    lines.push(Line::from(head));
+    let before = e.figures(None).unwrap_or(&[]);
+    let cell = |fig: Option<&JointFigures>| -> String {
+        let exc = num(fig.map(|f| f.excursion.joint_mean_excursion_deg), 6);
+        if truth {
+            format!("{exc} /{}", num(fig.and_then(rms), 6))
+        } else {
+            exc
+        }
+    };
+    let mut rows: Vec<(String, Vec<String>)> = vec![];
+    for (k, j) in before.iter().enumerate() {
+        let mut cells = vec![cell(Some(j))];
+        for v in Variant::ALL {
+            let fig = e
+                .figures(Some(v))
+                .and_then(|fs| fs.iter().find(|f| f.joint == j.joint));
+            cells.push(cell(fig));
+        }
+        let marker = if k == app.joint { "> " } else { "  " };
+        rows.push((format!("{marker}{}", fit(&j.joint, nw)), cells));
+    }
+    // Mean over joints.
+    let mut mean = vec![num(e.mean_excursion(None), 6)];
+    for v in Variant::ALL {
+        mean.push(num(e.mean_excursion(Some(v)), 6));
+    }
+    for (k, (name, cells)) in rows.iter().enumerate() {
+        let mut spans = vec![Span::raw(format!("{name}{:>w$}", cells[0], w = cw))];
+        for (c, text) in cells[1..].iter().enumerate() {
+            let style = if c == app.compare_col {
+                theme.corrected
+            } else {
+                Style::default()
+            };
+            spans.push(Span::raw(" "));
+            spans.push(Span::styled(
+                format!("{text:>w$}", w = cw.max(15) - 1),
+                style,
+            ));
+        }
+        let mut line = Line::from(spans);
+        if k == app.joint {
+            line = line.style(theme.selected);
+        }
+        lines.push(line);
+    }
+    let mut spans = vec![Span::styled(
+        format!("  {}{:>w$}", fit("mean", nw), mean[0], w = cw),
+        theme.header,
+    )];
+    for text in &mean[1..] {
+        spans.push(Span::styled(
+            format!(" {text:>w$}", w = cw.max(15) - 1),
+            theme.header,
+        ));
+    }
+    lines.push(Line::from(spans));
+    lines.push(Line::from(""));
+    let mut status = vec![];
+    for v in Variant::ALL {
+        let s = super::trials::variant_status(e, v);
+        let saved = e
+            .results
+            .get(&v)
+            .and_then(|r| r.saved.clone())
+            .map(|p| format!(" -> {p}"))
+            .unwrap_or_default();
+        status.push(Line::from(format!("  {:<15}{s}{saved}", v.name())));
+    }
+    lines.extend(status);
+    if e.results.is_empty() && e.running.is_none() {
+        lines.push(Line::from(Span::styled(
+            "  not run yet: r runs all variants",
+            theme.warn,
+        )));
+    }
+    if let Some(m) = e.loaded().and_then(|l| l.truth_error.clone()) {
+        lines.push(Line::from(Span::styled(
+            format!("  truth: {m}"),
+            theme.warn,
+        )));
+    }
+    f.render_widget(Paragraph::new(lines), area);
+}

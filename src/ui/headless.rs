@@ -1,0 +1,223 @@
+//! Screens without a terminal: build the state synchronously, draw it into a
+//! ratatui `TestBackend`, and turn the buffer into text (optionally with ANSI
+//! SGR colours). `acmw render` and the snapshot tests share this path.
+
+use super::app::{open, update, App, Msg, Overlay, Screen};
+use super::jobs::{list_trials, load_limits, SyncRunner};
+use super::render::render;
+use super::theme::Theme;
+use crate::acm::Variant;
+use ratatui::backend::TestBackend;
+use ratatui::buffer::{Buffer, CellWidth};
+use ratatui::style::{Color, Modifier};
+use ratatui::Terminal;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The screens `acmw render` knows.
+pub const SCREENS: [&str; 5] = ["trials", "trial", "compare", "limits", "help"];
+
+/// A workbench over `dir` (shown as `dir_label`) with every trial read.
+pub fn load_app(dir_label: &str, dir: &Path, limits_dir: &Path) -> Result<App, String> {
+    let files = list_trials(dir)?;
+    let limits = load_limits(limits_dir)?;
+    let mut app = App::new(dir_label.to_string(), dir.to_path_buf(), files, limits);
+    let start = app.start();
+    SyncRunner::run(&mut app, start);
+    Ok(app)
+}
+
+/// What to show.
+#[derive(Debug, Clone, Default)]
+pub struct Show {
+    pub screen: String,
+    pub trial: Option<String>,
+    pub joint: Option<String>,
+    pub variant: Option<Variant>,
+}
+
+/// Puts `app` on a screen, running the corrections a trial screen needs.
+pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
+    if !SCREENS.contains(&s.screen.as_str()) {
+        return Err(format!(
+            "unknown screen '{}' (screens: {})",
+            s.screen,
+            SCREENS.join(", ")
+        ));
+    }
+    if let Some(v) = s.variant {
+        app.variant = v;
+    }
+    let trial = match &s.trial {
+        Some(t) => {
+            let e = app
+                .entry(t)
+                .ok_or_else(|| format!("no trial '{t}' in {}", app.dir_label))?;
+            if let Some(m) = match &e.load {
+                super::app::LoadState::Failed(m) => Some(m.clone()),
+                _ => None,
+            } {
+                if matches!(s.screen.as_str(), "trial" | "compare") {
+                    return Err(m);
+                }
+            }
+            Some(t.clone())
+        }
+        None => app
+            .trials
+            .iter()
+            .find(|e| e.loaded().is_some())
+            .map(|e| e.file.clone()),
+    };
+    if let Some(t) = &trial {
+        app.select_file(t);
+    }
+    match s.screen.as_str() {
+        "trial" | "compare" => {
+            let t = trial.ok_or("no trial could be read")?;
+            open(app, t.clone());
+            if let Some(j) = &s.joint {
+                app.joint = app
+                    .open_joints()
+                    .iter()
+                    .position(|x| x == j)
+                    .ok_or_else(|| format!("no joint '{j}' in {t}"))?;
+            }
+            if app.open_entry().is_some_and(|e| e.results.is_empty()) {
+                let fx = update(
+                    app,
+                    Msg::Key(ratatui::crossterm::event::KeyEvent::from(
+                        ratatui::crossterm::event::KeyCode::Char('r'),
+                    )),
+                );
+                SyncRunner::run(app, fx);
+            }
+            app.message = None;
+            if s.screen == "compare" {
+                app.screen = Screen::Compare;
+            }
+        }
+        "limits" => app.screen = Screen::Limits,
+        "help" => app.overlay = Some(Overlay::Help),
+        _ => {}
+    }
+    Ok(())
+}
+
+/// Draws the app into a buffer of `w` x `h` cells.
+pub fn draw(app: &App, theme: &Theme, w: u16, h: u16) -> Buffer {
+    let mut t = Terminal::new(TestBackend::new(w, h)).expect("test backend");
+    t.draw(|f| render(app, theme, f)).expect("draw");
+    t.backend().buffer().clone()
+}
+
+/// The buffer's characters, one line per row (as the snapshots hold them).
+pub fn buffer_text(buf: &Buffer) -> String {
+    let mut out = String::new();
+    let w = buf.area.width as usize;
+    if w == 0 {
+        return out;
+    }
+    for row in buf.content.chunks(w) {
+        let mut skip = 0u16;
+        for c in row {
+            if skip == 0 {
+                out.push_str(c.symbol());
+            }
+            skip = skip.max(c.cell_width()).saturating_sub(1);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+fn sgr_colour(c: Color, fg: bool) -> Option<String> {
+    let base = if fg { 30 } else { 40 };
+    let n = match c {
+        Color::Reset => return None,
+        Color::Black => base,
+        Color::Red => base + 1,
+        Color::Green => base + 2,
+        Color::Yellow => base + 3,
+        Color::Blue => base + 4,
+        Color::Magenta => base + 5,
+        Color::Cyan => base + 6,
+        Color::Gray => base + 7,
+        Color::DarkGray => base + 60,
+        Color::LightRed => base + 61,
+        Color::LightGreen => base + 62,
+        Color::LightYellow => base + 63,
+        Color::LightBlue => base + 64,
+        Color::LightMagenta => base + 65,
+        Color::LightCyan => base + 66,
+        Color::White => base + 67,
+        Color::Indexed(i) => return Some(format!("{};5;{i}", base + 8)),
+        Color::Rgb(r, g, b) => return Some(format!("{};2;{r};{g};{b}", base + 8)),
+    };
+    Some(n.to_string())
+}
+
+/// The buffer with ANSI SGR codes wherever the style changes.
+pub fn buffer_ansi(buf: &Buffer) -> String {
+    let mut out = String::new();
+    let w = buf.area.width as usize;
+    if w == 0 {
+        return out;
+    }
+    for row in buf.content.chunks(w) {
+        let mut last: Option<String> = None;
+        let mut skip = 0u16;
+        for c in row {
+            let mut codes = vec!["0".to_string()];
+            let m = c.modifier;
+            for (flag, code) in [
+                (Modifier::BOLD, "1"),
+                (Modifier::DIM, "2"),
+                (Modifier::ITALIC, "3"),
+                (Modifier::UNDERLINED, "4"),
+                (Modifier::REVERSED, "7"),
+            ] {
+                if m.contains(flag) {
+                    codes.push(code.into());
+                }
+            }
+            codes.extend(sgr_colour(c.fg, true));
+            codes.extend(sgr_colour(c.bg, false));
+            let sgr = format!("\x1b[{}m", codes.join(";"));
+            if last.as_deref() != Some(sgr.as_str()) {
+                out.push_str(&sgr);
+                last = Some(sgr);
+            }
+            if skip == 0 {
+                out.push_str(c.symbol());
+            }
+            skip = skip.max(c.cell_width()).saturating_sub(1);
+        }
+        let _ = write!(out, "\x1b[0m");
+        out.push('\n');
+    }
+    out
+}
+
+/// Writes a small fixed folder of trials into `dir` (created): `knee.csv`
+/// (knee_calf_z15, 60 s), `fb.csv.gz` (full_body_clean, 30 s), both with their
+/// truth beside, and `broken.csv` (not a trial). Snapshot tests, the `acmw
+/// render` test and demos use it.
+pub fn write_demo_folder(dir: &Path) -> Result<(), String> {
+    use crate::simulate::{preset, simulate};
+    use crate::trial::{write_trial, TrialFormat};
+    std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    for (name, preset_name, seconds) in [
+        ("knee.csv", "knee_calf_z15", 60.0),
+        ("fb.csv.gz", "full_body_clean", 30.0),
+    ] {
+        let mut cfg = preset(preset_name).ok_or("unknown preset")?;
+        cfg.duration_s = seconds;
+        let sim = simulate(&cfg).map_err(|e| e.to_string())?;
+        let out = dir.join(name);
+        write_trial(&sim.trial, &out, TrialFormat::QuatCsv).map_err(|e| e.to_string())?;
+        sim.truth.save_beside(&out).map_err(|e| e.to_string())?;
+    }
+    std::fs::write(dir.join("broken.csv"), "garbage,1,2\n").map_err(|e| e.to_string())?;
+    Ok(())
+}

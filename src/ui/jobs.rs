@@ -1,0 +1,302 @@
+//! The work behind effects: reading trials, correcting, saving. Each function
+//! returns the message that reports its outcome; the runtime calls them on
+//! worker threads, tests call them in line (see [`SyncRunner`]).
+
+use super::app::{update, App, Effect, LimitsState, Loaded, Msg, RunJob};
+use crate::acm::{correct_trial, recorrect, Correction, RunControl, Variant};
+use crate::limits::{LimitTable, SettingsFile, BUILTIN_SETTINGS, BUILTIN_TABLES};
+use crate::metrics::trial_figures;
+use crate::model::{Model, BUILTIN_MODELS};
+use crate::report::ReportInput;
+use crate::sidecar::{default_output, SaveRequest};
+use crate::trial::{detect_format, is_trial_file, read_trial, read_trial_header, TrialError};
+use crate::truth::load_truth_beside;
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// Trial file names in `dir` (non-recursive), sorted.
+pub fn list_trials(dir: &Path) -> Result<Vec<String>, String> {
+    let rd = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut names: Vec<String> = rd
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_type().map(|t| !t.is_dir()).unwrap_or(false))
+        .map(|e| e.path())
+        .filter(|p| is_trial_file(p))
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    names.sort();
+    Ok(names)
+}
+
+/// The built-in model that recognises most IMUs of the trial (as `acmw correct`).
+pub fn detect_model(path: &Path) -> Model {
+    let mut best: Option<(usize, Model)> = None;
+    for (name, _) in BUILTIN_MODELS {
+        let model = Model::builtin(name).expect("built-in model is valid");
+        let known = read_trial_header(path, &model)
+            .map(|h| h.imus.iter().filter(|i| model.imus.contains(i)).count())
+            .unwrap_or(0);
+        if best.as_ref().is_none_or(|(k, _)| known > *k) {
+            best = Some((known, model));
+        }
+    }
+    best.expect("there are built-in models").1
+}
+
+/// The limits the workbench edits: `dir/settings.toml` and the table it names,
+/// or the built-in ones when `dir` (normally `./joint_limits`) does not have them;
+/// saving creates them there. Resolved as the command-line tools do.
+pub fn load_limits(dir: &Path) -> Result<LimitsState, String> {
+    let settings_path = dir.join("settings.toml");
+    let settings = if settings_path.exists() {
+        let text = std::fs::read_to_string(&settings_path)
+            .map_err(|e| format!("{}: cannot read: {e}", settings_path.display()))?;
+        SettingsFile::parse(&text, &settings_path.display().to_string())
+            .map_err(|e| e.to_string())?
+    } else {
+        SettingsFile::parse(BUILTIN_SETTINGS, "<built-in settings.toml>")
+            .map_err(|e| e.to_string())?
+    };
+    let p = dir.join(&settings.table);
+    let (table, source) = if p.exists() {
+        (
+            LimitTable::load(&p).map_err(|e| e.to_string())?,
+            p.display().to_string(),
+        )
+    } else {
+        let (name, text) = BUILTIN_TABLES
+            .iter()
+            .find(|(n, _)| *n == settings.table)
+            .unwrap_or(&BUILTIN_TABLES[0]);
+        let source = format!("<built-in {name}>");
+        (
+            LimitTable::parse(text, &source).map_err(|e| e.to_string())?,
+            source,
+        )
+    };
+    Ok(LimitsState::new(
+        dir.to_path_buf(),
+        settings.table.clone(),
+        source,
+        table,
+        settings,
+    ))
+}
+
+/// Reads the limit files in `dir` as they are on disk now (None if absent or bad).
+pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<(LimitTable, SettingsFile)> {
+    let s = std::fs::read_to_string(dir.join("settings.toml")).ok()?;
+    let settings = SettingsFile::parse(&s, "settings.toml").ok()?;
+    let name = if settings.table.is_empty() {
+        table_name
+    } else {
+        &settings.table
+    };
+    let table = LimitTable::load(&dir.join(name)).ok()?;
+    Some((table, settings))
+}
+
+/// Reads one trial: the trial, its model, its truth and its uncorrected figures.
+pub fn load_trial(file: &str, path: &Path, limits: &LimitTable) -> Msg {
+    let shown = |e: TrialError| {
+        TrialError {
+            file: file.to_string(),
+            ..e
+        }
+        .to_string()
+    };
+    let result = (|| {
+        let model = detect_model(path);
+        let (format, gzip) = detect_format(path).map_err(shown)?;
+        let mut trial = read_trial(path, &model).map_err(shown)?;
+        trial.name = file.to_string();
+        let (truth, truth_error) = match load_truth_beside(path, &model) {
+            None => (None, None),
+            Some(Ok(t)) => match t.check_against(&trial) {
+                Ok(()) => (Some(t.segments), None),
+                Err(m) => (None, Some(m)),
+            },
+            Some(Err(e)) => (None, Some(shown(e))),
+        };
+        let before = trial_figures(&trial, None, truth.as_ref(), &model, limits);
+        Ok(Arc::new(Loaded {
+            trial,
+            model,
+            format,
+            gzip,
+            truth,
+            truth_error,
+            before,
+        }))
+    })();
+    Msg::Loaded(file.to_string(), result)
+}
+
+/// Corrects a trial with every variant (or re-corrects the edited joints).
+pub fn run_job(job: &RunJob, cancel: &AtomicBool, progress: &(dyn Fn(u8) + Sync)) -> Msg {
+    let l = &job.loaded;
+    let n = Variant::ALL.len();
+    let result = (|| {
+        let mut out: Vec<Arc<Correction>> = Vec::with_capacity(n);
+        for (k, v) in Variant::ALL.into_iter().enumerate() {
+            let report = move |done: usize, total: usize| {
+                let frac = if total == 0 {
+                    1.0
+                } else {
+                    done as f64 / total as f64
+                };
+                progress(((k as f64 + frac) * 100.0 / n as f64) as u8);
+            };
+            let control = RunControl {
+                cancel: Some(cancel),
+                progress: Some(&report),
+            };
+            let c = match &job.recorrect {
+                Some((previous, joints)) => {
+                    let names: Vec<&str> = joints.iter().map(String::as_str).collect();
+                    recorrect(
+                        &l.trial,
+                        &l.model,
+                        &job.limits,
+                        &job.settings,
+                        &previous[k],
+                        &names,
+                        &control,
+                    )
+                }
+                None => correct_trial(&l.trial, &l.model, &job.limits, &job.settings, v, &control),
+            }
+            .map_err(|e| e.to_string())?;
+            out.push(Arc::new(c));
+        }
+        let input = ReportInput {
+            trial: &l.trial,
+            model: &l.model,
+            limits: &job.limits,
+            limits_source: &job.limits_source,
+            settings: &job.settings,
+            truth: l.truth.as_ref(),
+        };
+        let corrections: Vec<Correction> = out.iter().map(|c| (**c).clone()).collect();
+        let report = input.report(&corrections);
+        Ok((out, report))
+    })();
+    Msg::RunDone {
+        file: job.file.clone(),
+        gen: job.gen,
+        result,
+    }
+}
+
+/// Saves a corrected trial and its sidecar at the default output path.
+pub fn save_variant(
+    dir: &Path,
+    file: &str,
+    path: &Path,
+    loaded: &Loaded,
+    correction: &Correction,
+    limits: &LimitTable,
+    limits_source: &str,
+) -> Msg {
+    let output = default_output(path, correction.variant, loaded.format, loaded.gzip);
+    let req = SaveRequest {
+        input: path,
+        input_format: loaded.format,
+        trial: &loaded.trial,
+        correction,
+        model: &loaded.model,
+        limits,
+        limits_source,
+        output: &output,
+        output_format: loaded.format,
+        sidecar: None,
+    };
+    let shown = output
+        .strip_prefix(dir)
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|_| output.clone());
+    Msg::Saved {
+        file: file.to_string(),
+        variant: correction.variant,
+        result: req
+            .save()
+            .map(|_| shown.display().to_string())
+            .map_err(|e| format!("{e:#}")),
+    }
+}
+
+/// Saves the table and settings in `dir` (created if missing).
+pub fn save_limits(dir: &Path, table_name: &str, table_csv: &str, settings_toml: &str) -> Msg {
+    let result = (|| {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let table: PathBuf = dir.join(table_name);
+        crate::save::atomic_write(&table, table_csv.as_bytes())
+            .map_err(|e| format!("{}: {e}", table.display()))?;
+        let settings = dir.join("settings.toml");
+        crate::save::atomic_write(&settings, settings_toml.as_bytes())
+            .map_err(|e| format!("{}: {e}", settings.display()))?;
+        Ok(table.display().to_string())
+    })();
+    Msg::LimitsSaved(result)
+}
+
+/// Carries out one effect in line; the messages it produces.
+pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
+    match effect {
+        Effect::Load { files, limits } => files
+            .iter()
+            .map(|(f, p)| load_trial(f, p, &limits))
+            .collect(),
+        Effect::Run(job) => {
+            let cancel = AtomicBool::new(false);
+            vec![run_job(&job, &cancel, &|_| {})]
+        }
+        Effect::SaveVariant {
+            file,
+            path,
+            loaded,
+            correction,
+            limits,
+            limits_source,
+        } => vec![save_variant(
+            app_dir,
+            &file,
+            &path,
+            &loaded,
+            &correction,
+            &limits,
+            &limits_source,
+        )],
+        Effect::SaveLimits {
+            dir,
+            table_name,
+            table_csv,
+            settings_toml,
+        } => vec![save_limits(&dir, &table_name, &table_csv, &settings_toml)],
+        Effect::Debounce => vec![Msg::RecorrectDue],
+    }
+}
+
+/// Runs effects synchronously until none are left (tests and `acmw render`).
+pub struct SyncRunner;
+
+impl SyncRunner {
+    /// Applies `msg`, then carries out every resulting effect to completion.
+    pub fn send(app: &mut App, msg: Msg) {
+        let effects = update(app, msg);
+        SyncRunner::run(app, effects);
+    }
+
+    /// Carries out `effects` and everything they lead to.
+    pub fn run(app: &mut App, effects: Vec<Effect>) {
+        let mut queue: VecDeque<Effect> = effects.into();
+        while let Some(e) = queue.pop_front() {
+            let dir = app.dir.clone();
+            for m in execute(&dir, e) {
+                queue.extend(update(app, m));
+            }
+        }
+    }
+}

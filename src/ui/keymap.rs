@@ -1,0 +1,122 @@
+//! Keys become actions; the help overlay is generated from the same table.
+
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+/// What a key asks for; the screen in front decides what it means there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    Quit,
+    Help,
+    Back,
+    Up,
+    Down,
+    Left,
+    Right,
+    PageUp,
+    PageDown,
+    Enter,
+    Filter,
+    Sort,
+    Run,
+    Variant,
+    Compare,
+    Limits,
+    ZoomIn,
+    ZoomOut,
+    CursorLeft,
+    CursorRight,
+    Home,
+    End,
+    Save,
+    Choose,
+    Marker,
+    KeepMine,
+    TakeFile,
+    Yes,
+    No,
+}
+
+/// Where a binding applies, for the help overlay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scope {
+    Everywhere,
+    Trials,
+    Trial,
+    Compare,
+    Limits,
+}
+
+impl Scope {
+    pub fn title(self) -> &'static str {
+        match self {
+            Scope::Everywhere => "everywhere",
+            Scope::Trials => "trials",
+            Scope::Trial => "trial",
+            Scope::Compare => "compare",
+            Scope::Limits => "limits",
+        }
+    }
+}
+
+/// One binding: the key, what it does, where.
+pub struct Binding {
+    pub keys: &'static str,
+    pub code: &'static [KeyCode],
+    pub action: Action,
+    pub scope: Scope,
+    pub help: &'static str,
+}
+
+/// Every binding, in help order.
+#[rustfmt::skip]
+pub const BINDINGS: &[Binding] = &[
+    Binding { keys: "q", code: &[KeyCode::Char('q')], action: Action::Quit, scope: Scope::Everywhere, help: "quit (asks if unsaved)" },
+    Binding { keys: "?", code: &[KeyCode::Char('?'), KeyCode::F(1)], action: Action::Help, scope: Scope::Everywhere, help: "this help" },
+    Binding { keys: "Esc", code: &[KeyCode::Esc, KeyCode::Backspace], action: Action::Back, scope: Scope::Everywhere, help: "back / cancel" },
+    Binding { keys: "Up/Down", code: &[KeyCode::Up, KeyCode::Char('k')], action: Action::Up, scope: Scope::Everywhere, help: "move selection" },
+    Binding { keys: "", code: &[KeyCode::Down, KeyCode::Char('j')], action: Action::Down, scope: Scope::Everywhere, help: "" },
+    Binding { keys: "PgUp/PgDn", code: &[KeyCode::PageUp], action: Action::PageUp, scope: Scope::Everywhere, help: "page" },
+    Binding { keys: "", code: &[KeyCode::PageDown], action: Action::PageDown, scope: Scope::Everywhere, help: "" },
+    Binding { keys: "Enter", code: &[KeyCode::Enter], action: Action::Enter, scope: Scope::Everywhere, help: "open / edit / commit" },
+    Binding { keys: "/", code: &[KeyCode::Char('/')], action: Action::Filter, scope: Scope::Trials, help: "filter by name" },
+    Binding { keys: "s", code: &[KeyCode::Char('s')], action: Action::Sort, scope: Scope::Trials, help: "sort name/dur/excursion" },
+    Binding { keys: "r", code: &[KeyCode::Char('r')], action: Action::Run, scope: Scope::Trial, help: "run all variants" },
+    Binding { keys: "v", code: &[KeyCode::Char('v')], action: Action::Variant, scope: Scope::Trial, help: "next variant" },
+    Binding { keys: "c", code: &[KeyCode::Char('c')], action: Action::Compare, scope: Scope::Trial, help: "compare and save" },
+    Binding { keys: "l", code: &[KeyCode::Char('l')], action: Action::Limits, scope: Scope::Everywhere, help: "limits editor" },
+    Binding { keys: "+/-", code: &[KeyCode::Char('+'), KeyCode::Char('=')], action: Action::ZoomIn, scope: Scope::Trial, help: "zoom (or mouse wheel)" },
+    Binding { keys: "", code: &[KeyCode::Char('-')], action: Action::ZoomOut, scope: Scope::Trial, help: "" },
+    Binding { keys: "Left/Right", code: &[KeyCode::Left, KeyCode::Char('h')], action: Action::Left, scope: Scope::Trial, help: "pan time / pick column" },
+    Binding { keys: "", code: &[KeyCode::Right], action: Action::Right, scope: Scope::Trial, help: "" },
+    Binding { keys: ", .", code: &[KeyCode::Char(',')], action: Action::CursorLeft, scope: Scope::Trial, help: "move the cursor" },
+    Binding { keys: "", code: &[KeyCode::Char('.')], action: Action::CursorRight, scope: Scope::Trial, help: "" },
+    Binding { keys: "Home/End", code: &[KeyCode::Home], action: Action::Home, scope: Scope::Trial, help: "cursor to start / end" },
+    Binding { keys: "", code: &[KeyCode::End], action: Action::End, scope: Scope::Trial, help: "" },
+    Binding { keys: "m", code: &[KeyCode::Char('m')], action: Action::Marker, scope: Scope::Trial, help: "braille / dot marker" },
+    Binding { keys: "Space", code: &[KeyCode::Char(' ')], action: Action::Choose, scope: Scope::Compare, help: "choose the variant" },
+    Binding { keys: "w", code: &[KeyCode::Char('w')], action: Action::Save, scope: Scope::Everywhere, help: "save variant / limits" },
+    Binding { keys: "K / T", code: &[KeyCode::Char('K')], action: Action::KeepMine, scope: Scope::Limits, help: "reload: mine / file's" },
+    Binding { keys: "", code: &[KeyCode::Char('T')], action: Action::TakeFile, scope: Scope::Limits, help: "" },
+    Binding { keys: "y / n", code: &[KeyCode::Char('y')], action: Action::Yes, scope: Scope::Everywhere, help: "answer a question" },
+    Binding { keys: "", code: &[KeyCode::Char('n')], action: Action::No, scope: Scope::Everywhere, help: "" },
+];
+
+/// The action of a key press, if any. Ctrl-combinations are never bound.
+pub fn action(key: &KeyEvent) -> Option<Action> {
+    if key.modifiers.contains(KeyModifiers::CONTROL) || key.modifiers.contains(KeyModifiers::ALT) {
+        return None;
+    }
+    BINDINGS
+        .iter()
+        .find(|b| b.code.contains(&key.code))
+        .map(|b| b.action)
+}
+
+/// Help lines: (keys, text, scope) of every documented binding.
+pub fn help_lines() -> Vec<(&'static str, &'static str, Scope)> {
+    BINDINGS
+        .iter()
+        .filter(|b| !b.keys.is_empty())
+        .map(|b| (b.keys, b.help, b.scope))
+        .collect()
+}

@@ -1,0 +1,24 @@
+//! The terminal workbench (`acmw` without a subcommand). The only part of the
+//! library that knows ratatui.
+//!
+//! * [`app`]: state, messages and `update(&mut App, Msg) -> Vec<Effect>` (no I/O);
+//! * [`render`] and one module per screen ([`trials`], [`trial`], [`compare`],
+//!   [`limits`]): pure drawing functions of the state;
+//! * [`jobs`]: the work behind effects, and a synchronous runner for tests;
+//! * [`runtime`]: terminal, event loop, workers, file watching;
+//! * [`headless`]: any screen as text (`acmw render`, snapshot tests).
+
+pub mod app;
+pub mod compare;
+pub mod headless;
+pub mod jobs;
+pub mod keymap;
+pub mod limits;
+pub mod render;
+pub mod runtime;
+pub mod theme;
+pub mod trial;
+pub mod trials;
+
+#[cfg(test)]
+mod tests;

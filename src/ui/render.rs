@@ -1,0 +1,254 @@
+//! Drawing: a pure function of the state. One module per screen; this one
+//! draws the frame around them (title, status bar) and the overlays.
+
+use super::app::{App, Overlay, Screen};
+use super::keymap::{help_lines, Scope};
+use super::theme::Theme;
+use super::{compare, limits, trial, trials};
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::Style;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Borders, Clear, Paragraph, Wrap};
+use ratatui::Frame;
+
+/// Draws the whole workbench.
+pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
+    let area = f.area();
+    if area.width < 20 || area.height < 5 {
+        f.render_widget(
+            Paragraph::new("acmw: window too small").wrap(Wrap { trim: true }),
+            area,
+        );
+        return;
+    }
+    let [top, body, bottom] = Layout::vertical([
+        Constraint::Length(1),
+        Constraint::Min(1),
+        Constraint::Length(1),
+    ])
+    .areas(area);
+    title_bar(app, theme, f, top);
+    match app.screen {
+        Screen::Trials => trials::render(app, theme, f, body),
+        Screen::Trial => trial::render(app, theme, f, body),
+        Screen::Compare => compare::render(app, theme, f, body),
+        Screen::Limits => limits::render(app, theme, f, body),
+    }
+    status_bar(app, theme, f, bottom);
+    match &app.overlay {
+        Some(Overlay::Help) => help(app, theme, f, body),
+        Some(Overlay::QuitConfirm) => quit_confirm(app, theme, f, body),
+        Some(Overlay::ReloadConflict) => reload_conflict(app, theme, f, body),
+        None => {}
+    }
+}
+
+fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+    let screen = match app.screen {
+        Screen::Trials => "Trials".to_string(),
+        Screen::Trial => format!("Trial {}", app.open.as_deref().unwrap_or("")),
+        Screen::Compare => format!("Compare {}", app.open.as_deref().unwrap_or("")),
+        Screen::Limits => "Limits".to_string(),
+    };
+    let mut spans = vec![
+        Span::styled(" acmw ", theme.title),
+        Span::raw(format!("{}  ", app.dir_label)),
+        Span::styled(screen, theme.header),
+    ];
+    let right = format!(
+        "variant {}{} ",
+        app.variant,
+        if app.limits.dirty() { "  limits*" } else { "" }
+    );
+    let used: usize = spans.iter().map(|s| s.width()).sum();
+    let pad = (area.width as usize).saturating_sub(used + right.len());
+    spans.push(Span::raw(" ".repeat(pad)));
+    spans.push(Span::styled(right, theme.dim));
+    f.render_widget(Paragraph::new(Line::from(spans)), area);
+}
+
+/// Key hints of the screen in front.
+pub fn hints(app: &App) -> &'static str {
+    if app.filter_editing {
+        return "type to filter  Enter done  Esc clear";
+    }
+    if app.screen == Screen::Limits && app.limits.edit.is_some() {
+        return "type a value  Enter commit  Esc cancel";
+    }
+    match app.screen {
+        Screen::Trials => {
+            "Enter open  r run  / filter  s sort  v variant  l limits  ? help  q quit"
+        }
+        Screen::Trial => {
+            "r run  v variant  c compare  +- zoom  <- -> pan  , . cursor  l limits  ? help"
+        }
+        Screen::Compare => "<- -> variant  Space choose  w save  r run  Esc back  ? help",
+        Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
+    }
+}
+
+fn status_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+    let line = match &app.message {
+        Some((m, true)) => Line::from(vec![
+            Span::styled(" ! ", theme.error),
+            Span::styled(m.clone(), theme.error),
+        ]),
+        Some((m, false)) => Line::from(vec![Span::raw(" "), Span::styled(m.clone(), theme.ok)]),
+        None => Line::from(Span::raw(format!(" {}", hints(app)))),
+    };
+    f.render_widget(Paragraph::new(line).style(theme.status), area);
+}
+
+/// A centred rectangle of at most `w` x `h` inside `area`.
+pub fn centred(area: Rect, w: u16, h: u16) -> Rect {
+    let w = w.min(area.width);
+    let h = h.min(area.height);
+    Rect {
+        x: area.x + (area.width - w) / 2,
+        y: area.y + (area.height - h) / 2,
+        width: w,
+        height: h,
+    }
+}
+
+fn popup(f: &mut Frame, theme: &Theme, area: Rect, title: &str, lines: Vec<Line>) {
+    f.render_widget(Clear, area);
+    f.render_widget(
+        Paragraph::new(lines).wrap(Wrap { trim: false }).block(
+            Block::new()
+                .borders(Borders::ALL)
+                .title(Span::styled(format!(" {title} "), theme.title)),
+        ),
+        area,
+    );
+}
+
+fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
+    let order = [
+        Scope::Everywhere,
+        Scope::Trials,
+        Scope::Trial,
+        Scope::Compare,
+        Scope::Limits,
+    ];
+    let mut items: Vec<Line> = vec![];
+    for scope in order {
+        let entries: Vec<_> = help_lines().into_iter().filter(|l| l.2 == scope).collect();
+        if entries.is_empty() {
+            continue;
+        }
+        items.push(Line::from(Span::styled(scope.title(), theme.header)));
+        for (keys, text, _) in entries {
+            items.push(Line::from(vec![
+                Span::styled(format!(" {keys:<11}"), theme.title),
+                Span::raw(text),
+            ]));
+        }
+    }
+    // Two columns when the list is taller than the screen.
+    let inner_h = body.height.saturating_sub(3) as usize;
+    let two = items.len() > inner_h && body.width >= 78;
+    let w = if two { 78 } else { 50 };
+    let rows = if two {
+        items.len().div_ceil(2)
+    } else {
+        items.len()
+    };
+    let area = centred(body, w, rows as u16 + 2);
+    f.render_widget(Clear, area);
+    let block = Block::new()
+        .borders(Borders::ALL)
+        .title(Span::styled(" Keys (any key closes) ", theme.title));
+    let inner = block.inner(area);
+    f.render_widget(block, area);
+    if two {
+        let half = items.len().div_ceil(2);
+        let right = items.split_off(half);
+        let [a, b] = Layout::horizontal([Constraint::Ratio(1, 2); 2]).areas(inner);
+        f.render_widget(Paragraph::new(items), a);
+        f.render_widget(Paragraph::new(right), b);
+    } else {
+        f.render_widget(Paragraph::new(items), inner);
+    }
+}
+
+fn quit_confirm(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
+    let mut lines = vec![Line::from("Not saved yet:")];
+    if app.limits.dirty() {
+        lines.push(Line::from(format!(
+            "  limit edits ({})",
+            app.limits.table_name
+        )));
+    }
+    for t in app.trials.iter().filter(|t| t.unsaved_choice()) {
+        lines.push(Line::from(format!(
+            "  {} chosen variant {}",
+            t.file,
+            t.chosen.map(|v| v.name()).unwrap_or("")
+        )));
+    }
+    lines.push(Line::from(""));
+    lines.push(Line::from(vec![
+        Span::raw("Quit anyway?  "),
+        Span::styled("y", theme.title),
+        Span::raw(" quit   "),
+        Span::styled("n", theme.title),
+        Span::raw(" stay"),
+    ]));
+    let h = lines.len() as u16 + 2;
+    popup(f, theme, centred(body, 50, h), "Quit?", lines);
+}
+
+fn reload_conflict(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
+    let lines = vec![
+        Line::from(format!(
+            "{} changed on disk, and you have unsaved edits.",
+            app.limits.table_name
+        )),
+        Line::from(""),
+        Line::from(vec![
+            Span::styled("K", theme.title),
+            Span::raw(" keep mine (still unsaved)   "),
+            Span::styled("T", theme.title),
+            Span::raw(" take the file's"),
+        ]),
+    ];
+    popup(
+        f,
+        theme,
+        centred(body, 56, 6),
+        "Limits changed on disk",
+        lines,
+    );
+}
+
+/// `value` with one decimal, or `-`.
+pub fn num(v: Option<f64>, width: usize) -> String {
+    match v {
+        Some(v) if v.is_finite() => format!("{v:>width$.1}"),
+        _ => format!("{:>width$}", "-"),
+    }
+}
+
+/// Cuts `s` to `w` characters (with `~` when cut).
+pub fn fit(s: &str, w: usize) -> String {
+    let n = s.chars().count();
+    if n <= w {
+        format!("{s:<w$}")
+    } else if w == 0 {
+        String::new()
+    } else {
+        let mut t: String = s.chars().take(w - 1).collect();
+        t.push('~');
+        t
+    }
+}
+
+/// A style for selected rows.
+pub fn sel(theme: &Theme, selected: bool) -> Style {
+    if selected {
+        theme.selected
+    } else {
+        Style::default()
+    }
+}

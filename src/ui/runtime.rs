@@ -1,0 +1,330 @@
+//! The terminal side: raw mode, the event loop, worker threads, file watching.
+//!
+//! One loop, many producers: the input thread, workers, the watchers and the
+//! signal thread all send [`Event`]s over one channel; the loop takes one, drains
+//! the rest, updates the state and draws once, only when something happened.
+
+use super::app::{update, App, Effect, Msg};
+use super::jobs::{self, list_trials, load_limits, read_limits_on_disk};
+use super::render::render;
+use super::theme::Theme;
+use crate::trial::is_trial_file;
+use crossbeam_channel::{unbounded, Receiver, Sender};
+use notify::RecursiveMode;
+use notify_debouncer_full::{new_debouncer, DebounceEventResult};
+use ratatui::backend::CrosstermBackend;
+use ratatui::crossterm::event::{self, DisableMouseCapture, EnableMouseCapture, Event as CtEvent};
+use ratatui::crossterm::terminal::{
+    self, BeginSynchronizedUpdate, EndSynchronizedUpdate, EnterAlternateScreen,
+    LeaveAlternateScreen,
+};
+use ratatui::crossterm::{cursor, execute};
+use ratatui::Terminal;
+use std::collections::{BTreeSet, HashMap};
+use std::io::{stdout, Write as _};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Delay between a limit edit and the re-correction it causes.
+pub const RECORRECT_DEBOUNCE: Duration = Duration::from_millis(300);
+
+/// What reaches the event loop.
+#[allow(clippy::large_enum_variant)]
+enum Event {
+    Msg(Msg),
+    /// SIGTERM / SIGHUP / SIGINT: restore and leave.
+    Signal(i32),
+}
+
+/// Leaves raw mode, the alternate screen and mouse capture.
+pub fn restore_terminal() {
+    let mut out = stdout();
+    let _ = execute!(
+        out,
+        EndSynchronizedUpdate,
+        DisableMouseCapture,
+        LeaveAlternateScreen,
+        cursor::Show
+    );
+    let _ = terminal::disable_raw_mode();
+    let _ = out.flush();
+}
+
+/// Where the workbench looks.
+pub struct Options {
+    /// The trials folder as named by the user.
+    pub dir: PathBuf,
+    /// The limits folder (normally `./joint_limits`).
+    pub limits_dir: PathBuf,
+    pub theme: Theme,
+}
+
+/// Runs the workbench until the user quits (or a signal ends it).
+pub fn run(opts: Options) -> anyhow::Result<()> {
+    // Listing names is fast; the trials are read in the background.
+    let files = list_trials(&opts.dir).map_err(anyhow::Error::msg)?;
+    let limits = load_limits(&opts.limits_dir).map_err(anyhow::Error::msg)?;
+    let label = opts.dir.display().to_string();
+    let mut app = App::new(label, opts.dir.clone(), files, limits);
+
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        restore_terminal();
+        hook(info);
+    }));
+    terminal::enable_raw_mode()?;
+    execute!(stdout(), EnterAlternateScreen, EnableMouseCapture)?;
+    let result = event_loop(&mut app, &opts);
+    restore_terminal();
+    result
+}
+
+fn spawn_input(tx: Sender<Event>) {
+    std::thread::spawn(move || loop {
+        let msg = match event::read() {
+            Ok(CtEvent::Key(k)) => Msg::Key(k),
+            Ok(CtEvent::Mouse(m)) => Msg::Mouse(m),
+            Ok(CtEvent::Resize(..)) => Msg::Resize,
+            Ok(_) => continue,
+            Err(_) => return,
+        };
+        if tx.send(Event::Msg(msg)).is_err() {
+            return;
+        }
+    });
+}
+
+fn spawn_signals(tx: Sender<Event>) {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGTERM, SIGHUP, SIGINT]) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(s) = signals.forever().next() {
+            let _ = tx.send(Event::Signal(s));
+        }
+    });
+}
+
+type Watcher = notify_debouncer_full::Debouncer<
+    notify::RecommendedWatcher,
+    notify_debouncer_full::RecommendedCache,
+>;
+
+/// Watches the trials folder (non-recursive): changed and removed trial files.
+fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
+    let d = dir.to_path_buf();
+    let mut w = new_debouncer(
+        Duration::from_millis(250),
+        None,
+        move |r: DebounceEventResult| {
+            let Ok(events) = r else { return };
+            // Reading a file (ours included) raises access events: only
+            // creations, content changes, renames and removals count.
+            let paths: BTreeSet<PathBuf> = events
+                .iter()
+                .filter(|e| {
+                    use notify::event::{EventKind, ModifyKind};
+                    matches!(
+                        e.kind,
+                        EventKind::Create(_)
+                            | EventKind::Remove(_)
+                            | EventKind::Modify(
+                                ModifyKind::Data(_) | ModifyKind::Name(_) | ModifyKind::Any
+                            )
+                    )
+                })
+                .flat_map(|e| e.paths.iter().cloned())
+                .filter(|p| is_trial_file(p))
+                .collect();
+            for p in paths {
+                let Some(name) = p.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+                    continue;
+                };
+                let path = d.join(&name);
+                let msg = if path.is_file() {
+                    Msg::FileChanged(name, path)
+                } else {
+                    Msg::FileRemoved(name)
+                };
+                let _ = tx.send(Event::Msg(msg));
+            }
+        },
+    )
+    .ok()?;
+    w.watch(dir, RecursiveMode::NonRecursive).ok()?;
+    Some(w)
+}
+
+/// Watches the limits folder: a changed table or settings file is re-read.
+fn watch_limits(dir: &Path, table: String, tx: Sender<Event>) -> Option<Watcher> {
+    if !dir.is_dir() {
+        return None;
+    }
+    let d = dir.to_path_buf();
+    let mut w = new_debouncer(
+        Duration::from_millis(250),
+        None,
+        move |r: DebounceEventResult| {
+            let Ok(events) = r else { return };
+            let relevant = events
+                .iter()
+                .filter(|e| !matches!(e.kind, notify::EventKind::Access(_)))
+                .flat_map(|e| e.paths.iter())
+                .any(|p| {
+                    p.file_name()
+                        .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
+                });
+            if relevant {
+                if let Some((t, s)) = read_limits_on_disk(&d, &table) {
+                    let _ = tx.send(Event::Msg(Msg::LimitsOnDisk(t, s)));
+                }
+            }
+        },
+    )
+    .ok()?;
+    w.watch(dir, RecursiveMode::NonRecursive).ok()?;
+    Some(w)
+}
+
+struct Workers {
+    tx: Sender<Event>,
+    dir: PathBuf,
+    /// One job slot per trial: the cancel flag of its newest job.
+    jobs: HashMap<String, Arc<AtomicBool>>,
+    debounce: Option<Instant>,
+}
+
+impl Workers {
+    fn execute(&mut self, effect: Effect) {
+        let tx = self.tx.clone();
+        match effect {
+            Effect::Load { files, limits } => {
+                std::thread::spawn(move || {
+                    use rayon::prelude::*;
+                    files.par_iter().for_each(|(f, p)| {
+                        let _ = tx.send(Event::Msg(jobs::load_trial(f, p, &limits)));
+                    });
+                });
+            }
+            Effect::Run(job) => {
+                let cancel = Arc::new(AtomicBool::new(false));
+                if let Some(old) = self.jobs.insert(job.file.clone(), cancel.clone()) {
+                    old.store(true, Ordering::Relaxed);
+                }
+                std::thread::spawn(move || {
+                    let last = AtomicU8::new(0);
+                    let ptx = tx.clone();
+                    let progress = |pct: u8| {
+                        if last.swap(pct, Ordering::Relaxed) != pct {
+                            let _ = ptx.send(Event::Msg(Msg::Progress {
+                                file: job.file.clone(),
+                                gen: job.gen,
+                                pct,
+                            }));
+                        }
+                    };
+                    let msg = jobs::run_job(&job, &cancel, &progress);
+                    let _ = tx.send(Event::Msg(msg));
+                });
+            }
+            Effect::Debounce => self.debounce = Some(Instant::now() + RECORRECT_DEBOUNCE),
+            other => {
+                let dir = self.dir.clone();
+                std::thread::spawn(move || {
+                    for m in jobs::execute(&dir, other) {
+                        let _ = tx.send(Event::Msg(m));
+                    }
+                });
+            }
+        }
+    }
+}
+
+fn draw(
+    terminal: &mut Terminal<CrosstermBackend<std::io::Stdout>>,
+    app: &App,
+    theme: &Theme,
+) -> std::io::Result<()> {
+    execute!(stdout(), BeginSynchronizedUpdate)?;
+    terminal.draw(|f| render(app, theme, f))?;
+    execute!(stdout(), EndSynchronizedUpdate)
+}
+
+fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
+    let (tx, rx): (Sender<Event>, Receiver<Event>) = unbounded();
+    let mut terminal = Terminal::new(CrosstermBackend::new(stdout()))?;
+    terminal.clear()?;
+    draw(&mut terminal, app, &opts.theme)?;
+    spawn_input(tx.clone());
+    spawn_signals(tx.clone());
+    let _trials_watch = watch_trials(&opts.dir, tx.clone());
+    let mut limits_watch =
+        watch_limits(&opts.limits_dir, app.limits.table_name.clone(), tx.clone());
+    let mut workers = Workers {
+        tx: tx.clone(),
+        dir: opts.dir.clone(),
+        jobs: HashMap::new(),
+        debounce: None,
+    };
+    for e in app.start() {
+        workers.execute(e);
+    }
+    loop {
+        let first = match workers.debounce {
+            Some(at) => match rx.recv_timeout(at.saturating_duration_since(Instant::now())) {
+                Ok(e) => e,
+                Err(crossbeam_channel::RecvTimeoutError::Timeout) => {
+                    workers.debounce = None;
+                    Event::Msg(Msg::RecorrectDue)
+                }
+                Err(_) => break,
+            },
+            None => match rx.recv() {
+                Ok(e) => e,
+                Err(_) => break,
+            },
+        };
+        let mut batch = vec![first];
+        batch.extend(rx.try_iter());
+        for ev in batch {
+            match ev {
+                Event::Signal(s) => {
+                    if s == signal_hook::consts::SIGHUP && app.limits.dirty() {
+                        keep_unsaved(app);
+                    }
+                    return Ok(());
+                }
+                Event::Msg(m) => {
+                    let saved_limits = matches!(m, Msg::LimitsSaved(Ok(_)));
+                    for e in update(app, m) {
+                        workers.execute(e);
+                    }
+                    if saved_limits && limits_watch.is_none() {
+                        limits_watch = watch_limits(
+                            &opts.limits_dir,
+                            app.limits.table_name.clone(),
+                            tx.clone(),
+                        );
+                    }
+                }
+            }
+        }
+        if app.quit {
+            return Ok(());
+        }
+        draw(&mut terminal, app, &opts.theme)?;
+    }
+    Ok(())
+}
+
+/// On SIGHUP (an SSH drop), unsaved limit edits go beside the table as
+/// `<table>.unsaved` instead of being lost.
+fn keep_unsaved(app: &App) {
+    let l = &app.limits;
+    let _ = std::fs::create_dir_all(&l.dir);
+    let path = l.dir.join(format!("{}.unsaved", l.table_name));
+    let _ = crate::save::atomic_write(&path, l.table.to_csv().as_bytes());
+}

@@ -1,0 +1,320 @@
+//! Snapshot tests of every screen and state, flows driven through `update`,
+//! and a no-panic test at tiny sizes. Background work runs through
+//! [`SyncRunner`]; nothing sleeps.
+
+use super::app::{update, App, Msg, Overlay, Screen};
+use super::headless::{draw, load_app, show, write_demo_folder, Show, SCREENS};
+use super::jobs::SyncRunner;
+use super::render::render;
+use super::theme::Theme;
+use crate::acm::Variant;
+use ratatui::backend::TestBackend;
+use ratatui::crossterm::event::{KeyCode, KeyEvent};
+use ratatui::Terminal;
+use std::path::Path;
+
+/// Sizes every screen is checked at.
+pub const SIZES: [(u16, u16); 2] = [(80, 24), (120, 40)];
+
+struct Fixture {
+    tmp: tempfile::TempDir,
+}
+
+impl Fixture {
+    fn new() -> Fixture {
+        let tmp = tempfile::tempdir().unwrap();
+        write_demo_folder(&tmp.path().join("trials")).unwrap();
+        Fixture { tmp }
+    }
+
+    fn root(&self) -> &Path {
+        self.tmp.path()
+    }
+
+    fn app(&self) -> App {
+        load_app(
+            "trials",
+            &self.root().join("trials"),
+            &self.root().join("joint_limits"),
+        )
+        .unwrap()
+    }
+}
+
+fn key(app: &mut App, c: KeyCode) {
+    SyncRunner::send(app, Msg::Key(KeyEvent::from(c)));
+}
+
+fn keys(app: &mut App, s: &str) {
+    for c in s.chars() {
+        key(app, KeyCode::Char(c));
+    }
+}
+
+fn terminal(app: &App, w: u16, h: u16) -> Terminal<TestBackend> {
+    let mut t = Terminal::new(TestBackend::new(w, h)).unwrap();
+    t.draw(|f| render(app, &Theme::default(), f)).unwrap();
+    t
+}
+
+fn snap(name: &str, app: &App) {
+    for (w, h) in SIZES {
+        let t = terminal(app, w, h);
+        insta::assert_snapshot!(format!("{name}_{w}x{h}"), t.backend());
+    }
+}
+
+fn shown(app: &mut App, screen: &str, trial: &str) {
+    show(
+        app,
+        &Show {
+            screen: screen.into(),
+            trial: Some(trial.into()),
+            ..Show::default()
+        },
+    )
+    .unwrap();
+}
+
+#[test]
+fn screens() {
+    // The states `acmw render SCREEN --dir trials --trial knee.csv` prints.
+    let fx = Fixture::new();
+    for screen in SCREENS {
+        let mut app = fx.app();
+        shown(&mut app, screen, "knee.csv");
+        snap(screen, &app);
+    }
+}
+
+#[test]
+fn trials_states() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    // A load error row is part of the list.
+    assert!(app.trials.iter().any(|t| matches!(
+        &t.load,
+        super::app::LoadState::Failed(m) if m.starts_with("broken.csv:")
+    )));
+    // A run in progress at a fixed percentage.
+    app.select_file("knee.csv");
+    let fx_run = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('r'))));
+    assert_eq!(fx_run.len(), 1);
+    let gen = app.entry("knee.csv").unwrap().gen;
+    update(
+        &mut app,
+        Msg::Progress {
+            file: "knee.csv".into(),
+            gen,
+            pct: 42,
+        },
+    );
+    // A stale job's progress is ignored.
+    update(
+        &mut app,
+        Msg::Progress {
+            file: "knee.csv".into(),
+            gen: gen - 1,
+            pct: 7,
+        },
+    );
+    assert_eq!(app.entry("knee.csv").unwrap().running, Some(42));
+    snap("trials_running", &app);
+    // Filter and sort.
+    keys(&mut app, "/kn");
+    key(&mut app, KeyCode::Enter);
+    assert_eq!(app.visible().len(), 1);
+    snap("trials_filtered", &app);
+    key(&mut app, KeyCode::Esc);
+    assert_eq!(app.visible().len(), 3);
+    keys(&mut app, "s");
+    assert_eq!(app.sort, super::app::SortKey::Duration);
+    assert_eq!(app.trials[0].file, "fb.csv.gz");
+}
+
+#[test]
+fn trial_flow_run_compare_save() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    app.select_file("fb.csv.gz");
+    key(&mut app, KeyCode::Enter);
+    assert_eq!(app.screen, Screen::Trial);
+    assert!(app.open_entry().unwrap().results.is_empty());
+    keys(&mut app, "r");
+    let e = app.open_entry().unwrap();
+    assert_eq!(e.results.len(), 3);
+    assert_eq!(e.running, None);
+    // Zoom, pan, cursor, variant, joint.
+    keys(&mut app, "++");
+    assert_eq!(app.view.zoom, 2);
+    key(&mut app, KeyCode::Right);
+    assert!(app.view.start_s > 0.0);
+    key(&mut app, KeyCode::End);
+    assert!(app.view.cursor_s > 29.9);
+    keys(&mut app, "v");
+    assert_eq!(app.variant, Variant::DriftCentroid);
+    key(&mut app, KeyCode::Down);
+    assert_eq!(app.joint, 1);
+    snap("trial_zoomed", &app);
+    keys(&mut app, "m");
+    assert!(!app.view.braille);
+    // Compare: choose drift, quitting asks, save, the trials screen shows it.
+    keys(&mut app, "c");
+    assert_eq!(app.screen, Screen::Compare);
+    key(&mut app, KeyCode::Left);
+    key(&mut app, KeyCode::Char(' '));
+    assert_eq!(app.open_entry().unwrap().chosen, Some(Variant::Drift));
+    keys(&mut app, "q");
+    assert_eq!(app.overlay, Some(Overlay::QuitConfirm));
+    snap("quit_confirm", &app);
+    keys(&mut app, "n");
+    assert!(!app.quit && app.overlay.is_none());
+    keys(&mut app, "w");
+    let out = fx.root().join("trials/corrected/fb.drift.csv.gz");
+    assert!(out.exists(), "{:?}", app.message);
+    assert!(fx
+        .root()
+        .join("trials/corrected/fb.drift.csv.gz.acmw.json")
+        .exists());
+    assert_eq!(
+        app.open_entry().unwrap().results[&Variant::Drift]
+            .saved
+            .as_deref(),
+        Some("corrected/fb.drift.csv.gz")
+    );
+    snap("compare_saved", &app);
+    key(&mut app, KeyCode::Esc);
+    key(&mut app, KeyCode::Esc);
+    assert_eq!(app.screen, Screen::Trials);
+    assert!(!app.unsaved());
+    keys(&mut app, "q");
+    assert!(app.quit);
+}
+
+fn limits_app(fx: &Fixture) -> App {
+    let mut app = fx.app();
+    shown(&mut app, "trial", "knee.csv");
+    keys(&mut app, "l");
+    assert_eq!(app.screen, Screen::Limits);
+    // knee, Y, upper.
+    app.limits.row = app
+        .limits
+        .table
+        .rows
+        .iter()
+        .position(|r| r.joint == "knee" && r.axis == 1)
+        .unwrap();
+    app.limits.col = 4;
+    app
+}
+
+#[test]
+fn limits_editor_states_and_save() {
+    let fx = Fixture::new();
+    let mut app = limits_app(&fx);
+    snap("limits_clean", &app);
+    // Invalid as typed: cannot be committed.
+    key(&mut app, KeyCode::Enter);
+    for _ in 0..3 {
+        key(&mut app, KeyCode::Backspace);
+    }
+    keys(&mut app, "-1");
+    let err = app.limits.edit.as_ref().unwrap().error.clone().unwrap();
+    assert!(err.contains("upper_deg > lower_deg"), "{err}");
+    snap("limits_invalid", &app);
+    key(&mut app, KeyCode::Enter);
+    assert!(
+        app.limits.edit.is_some(),
+        "an invalid value cannot be committed"
+    );
+    key(&mut app, KeyCode::Esc);
+    assert!(app.limits.edit.is_none() && !app.limits.dirty());
+    // A valid edit re-runs the open trial's knee joint.
+    let before = app.entry("knee.csv").unwrap().results[&Variant::Drift]
+        .correction
+        .clone();
+    let gen = app.entry("knee.csv").unwrap().gen;
+    key(&mut app, KeyCode::Enter);
+    for _ in 0..3 {
+        key(&mut app, KeyCode::Backspace);
+    }
+    keys(&mut app, "60");
+    key(&mut app, KeyCode::Enter);
+    assert!(app.limits.dirty());
+    let e = app.entry("knee.csv").unwrap();
+    assert_eq!(e.gen, gen + 1, "re-corrected after the edit");
+    assert_ne!(e.results[&Variant::Drift].correction, before);
+    snap("limits_unsaved", &app);
+    // Save: CSV and settings written in joint_limits/ (created).
+    keys(&mut app, "w");
+    assert!(!app.limits.dirty());
+    let csv = std::fs::read_to_string(fx.root().join("joint_limits/table_3_2.csv")).unwrap();
+    assert!(csv.contains("knee,Y,flexion/extension,0,60,,0"), "{csv}");
+    assert!(fx.root().join("joint_limits/settings.toml").exists());
+    // Our own write coming back from the watcher changes nothing.
+    let (t, s) = (app.limits.table.clone(), app.limits.settings.clone());
+    update(&mut app, Msg::LimitsOnDisk(t, s));
+    assert!(app.overlay.is_none());
+}
+
+#[test]
+fn reload_conflict_keep_or_take() {
+    let fx = Fixture::new();
+    let mut app = limits_app(&fx);
+    let mut disk = app.limits.table.clone();
+    disk.rows[0].upper_deg = 29.0;
+    let settings = app.limits.settings.clone();
+    // Without edits: taken at once.
+    update(&mut app, Msg::LimitsOnDisk(disk.clone(), settings.clone()));
+    assert_eq!(app.limits.table.rows[0].upper_deg, 29.0);
+    assert!(!app.limits.dirty());
+    // With edits: asks.
+    key(&mut app, KeyCode::Enter);
+    key(&mut app, KeyCode::Backspace);
+    key(&mut app, KeyCode::Backspace);
+    key(&mut app, KeyCode::Backspace);
+    keys(&mut app, "99");
+    key(&mut app, KeyCode::Enter);
+    assert!(app.limits.dirty());
+    disk.rows[0].upper_deg = 28.0;
+    update(&mut app, Msg::LimitsOnDisk(disk.clone(), settings.clone()));
+    assert_eq!(app.overlay, Some(Overlay::ReloadConflict));
+    snap("reload_conflict", &app);
+    keys(&mut app, "K");
+    assert!(app.overlay.is_none() && app.limits.dirty());
+    assert_eq!(app.limits.saved_table.rows[0].upper_deg, 28.0);
+    disk.rows[0].upper_deg = 27.0;
+    update(&mut app, Msg::LimitsOnDisk(disk, settings));
+    keys(&mut app, "T");
+    assert!(!app.limits.dirty());
+    assert_eq!(app.limits.table.rows[0].upper_deg, 27.0);
+}
+
+#[test]
+fn folder_changes_update_the_list() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    let dir = fx.root().join("trials");
+    std::fs::copy(dir.join("knee.csv"), dir.join("again.csv")).unwrap();
+    SyncRunner::send(
+        &mut app,
+        Msg::FileChanged("again.csv".into(), dir.join("again.csv")),
+    );
+    assert_eq!(app.trials.len(), 4);
+    assert!(app.entry("again.csv").unwrap().loaded().is_some());
+    SyncRunner::send(&mut app, Msg::FileRemoved("knee.csv".into()));
+    assert_eq!(app.trials.len(), 3);
+    assert!(app.entry("knee.csv").is_none());
+}
+
+#[test]
+fn tiny_sizes_never_panic() {
+    let fx = Fixture::new();
+    for screen in SCREENS {
+        let mut app = fx.app();
+        shown(&mut app, screen, "fb.csv.gz");
+        for (w, h) in [(0, 0), (1, 1), (2, 2), (40, 12), (20, 5), (79, 6)] {
+            let _ = draw(&app, &Theme::default(), w, h);
+        }
+    }
+}

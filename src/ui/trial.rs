@@ -1,0 +1,385 @@
+//! The trial screen: joints, three angle charts with limits, figures.
+
+use super::app::{App, TrialEntry};
+use super::render::{fit, num, sel};
+use super::theme::Theme;
+use crate::limits::axis_name;
+use crate::metrics::{joint_angles, JointFigures};
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::Style;
+use ratatui::symbols::Marker;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
+use ratatui::Frame;
+
+/// Reduces the samples of `y` (at times `t`, ascending) inside `[t0, t1]` to at
+/// most two points per column of `columns`: the minimum and the maximum of the
+/// column, so that spikes stay visible. Fewer samples than columns are returned
+/// as they are (plus one neighbour each side, so lines reach the edges).
+pub fn envelope(t: &[f64], y: &[f64], t0: f64, t1: f64, columns: usize) -> Vec<(f64, f64)> {
+    let n = t.len().min(y.len());
+    if n == 0 || columns == 0 || t1 <= t0 {
+        return vec![];
+    }
+    let a = t[..n].partition_point(|&x| x < t0).saturating_sub(1);
+    let b = (t[..n].partition_point(|&x| x <= t1) + 1).min(n);
+    if b - a <= 2 * columns {
+        return (a..b).map(|i| (t[i], y[i])).collect();
+    }
+    let w = (t1 - t0) / columns as f64;
+    let mut out = Vec::with_capacity(2 * columns);
+    let mut col = usize::MAX;
+    let (mut lo, mut hi) = (0.0f64, 0.0f64);
+    let flush = |col: usize, lo: f64, hi: f64, out: &mut Vec<(f64, f64)>| {
+        let tc = t0 + (col as f64 + 0.5) * w;
+        out.push((tc, lo));
+        if hi != lo {
+            out.push((tc, hi));
+        }
+    };
+    for i in a..b {
+        let c = (((t[i] - t0) / w).floor().max(0.0) as usize).min(columns - 1);
+        if c != col {
+            if col != usize::MAX {
+                flush(col, lo, hi, &mut out);
+            }
+            col = c;
+            lo = y[i];
+            hi = y[i];
+        } else {
+            lo = lo.min(y[i]);
+            hi = hi.max(y[i]);
+        }
+    }
+    if col != usize::MAX {
+        flush(col, lo, hi, &mut out);
+    }
+    out
+}
+
+/// The sample index nearest to `ts`.
+fn index_at(t: &[f64], ts: f64) -> usize {
+    let i = t.partition_point(|&x| x < ts);
+    if i == 0 {
+        0
+    } else if i >= t.len() {
+        t.len().saturating_sub(1)
+    } else if ts - t[i - 1] <= t[i] - ts {
+        i - 1
+    } else {
+        i
+    }
+}
+
+fn joint_row(name: &str, before: Option<f64>, after: Option<f64>, w: usize) -> String {
+    format!(
+        "{}{}{}",
+        fit(name, w.saturating_sub(12)),
+        num(before, 6),
+        num(after, 6)
+    )
+}
+
+fn figures_of<'a>(figs: Option<&'a [JointFigures]>, joint: &str) -> Option<&'a JointFigures> {
+    figs?.iter().find(|f| f.joint == joint)
+}
+
+pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+    let Some(e) = app.open_entry() else {
+        f.render_widget(Paragraph::new("no trial open (Esc)"), area);
+        return;
+    };
+    let Some(l) = e.loaded() else {
+        f.render_widget(Paragraph::new("trial not loaded"), area);
+        return;
+    };
+    let left_w = if area.width >= 100 { 32 } else { 26 }.min(area.width / 2);
+    let [left, right] =
+        Layout::horizontal([Constraint::Length(left_w), Constraint::Min(1)]).areas(area);
+    let figs_h = 9.min(left.height / 2);
+    let [jl, fl] = Layout::vertical([Constraint::Min(1), Constraint::Length(figs_h)]).areas(left);
+
+    // Joint list.
+    let joints: Vec<&JointFigures> = l.before.iter().collect();
+    let after = e.figures(Some(app.variant));
+    let iw = jl.width.saturating_sub(1) as usize;
+    let mut lines = vec![Line::from(Span::styled(
+        format!(
+            "{}{:>6}{:>6}",
+            fit("joint", iw.saturating_sub(12)),
+            "exc",
+            "after"
+        ),
+        theme.header,
+    ))];
+    let rows = jl.height.saturating_sub(1) as usize;
+    let first = app.joint.saturating_sub(rows.saturating_sub(1));
+    for (k, j) in joints.iter().enumerate().skip(first).take(rows) {
+        let a = figures_of(after, &j.joint).map(|x| x.excursion.joint_mean_excursion_deg);
+        lines.push(
+            Line::from(joint_row(
+                &format!("{}{}", if k == app.joint { ">" } else { " " }, j.joint),
+                Some(j.excursion.joint_mean_excursion_deg),
+                a,
+                iw,
+            ))
+            .style(sel(theme, k == app.joint)),
+        );
+    }
+    f.render_widget(
+        Paragraph::new(lines).block(Block::new().borders(Borders::RIGHT)),
+        jl,
+    );
+    let Some(jf) = joints.get(app.joint) else {
+        return;
+    };
+    let joint_name = jf.joint.clone();
+    figures_panel(app, e, theme, f, fl, &joint_name);
+
+    // Charts.
+    let Some(joint) = l.model.joint(&joint_name) else {
+        return;
+    };
+    let raw = joint_angles(&l.trial, joint).unwrap_or_default();
+    let cor = e
+        .results
+        .get(&app.variant)
+        .and_then(|r| joint_angles(&r.correction.corrected, joint));
+    let lim = app
+        .limits
+        .table
+        .joint_limits(&joint.name, &joint.kind, true);
+    let t0 = l.trial.time_s.first().copied().unwrap_or(0.0);
+    let t: Vec<f64> = l.trial.time_s.iter().map(|x| x - t0).collect();
+    let d = l.trial.duration_s();
+    let (s0, s1) = app.view.span(d);
+    let ci = index_at(&t, app.view.cursor_s);
+    let [charts, foot] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
+    let parts = Layout::vertical([Constraint::Ratio(1, 3); 3]).split(charts);
+    for axis in 0..3 {
+        let y_raw: Vec<f64> = raw.iter().map(|a| a[axis]).collect();
+        let y_cor: Option<Vec<f64>> = cor.as_ref().map(|c| c.iter().map(|a| a[axis]).collect());
+        let range = lim.map(|l| l.range_deg[axis]);
+        let centroid = lim.and_then(|l| l.centroid_deg).map(|c| c[axis]);
+        let mut title = vec![Span::styled(format!(" {} ", axis_name(axis)), theme.header)];
+        if let Some([lo, hi]) = range {
+            title.push(Span::styled(format!("[{lo}, {hi}] "), theme.limit));
+        }
+        if let Some(c) = centroid {
+            title.push(Span::styled(format!("c {c} "), theme.centroid));
+        }
+        title.push(Span::styled(
+            format!("raw {} ", num(y_raw.get(ci).copied(), 0)),
+            theme.raw,
+        ));
+        if let Some(yc) = &y_cor {
+            title.push(Span::styled(
+                format!("{} {} ", app.variant, num(yc.get(ci).copied(), 0)),
+                theme.corrected,
+            ));
+        }
+        chart(
+            f,
+            parts[axis],
+            theme,
+            Line::from(title),
+            ChartData {
+                t: &t,
+                raw: &y_raw,
+                cor: y_cor.as_deref(),
+                range,
+                centroid,
+                span: (s0, s1),
+                cursor: app.view.cursor_s,
+                braille: app.view.braille,
+            },
+        );
+    }
+    let status = if let Some(p) = e.running {
+        format!("running {p}%")
+    } else if e.results.contains_key(&app.variant) {
+        format!("{} done", app.variant)
+    } else {
+        "not run: r runs all variants".to_string()
+    };
+    f.render_widget(
+        Paragraph::new(Line::from(vec![
+            Span::raw(format!(
+                " t {s0:.1}-{s1:.1} s  x{}  cursor {:.2} s  ",
+                1u32 << app.view.zoom.min(16),
+                app.view.cursor_s
+            )),
+            Span::styled(status, theme.dim),
+        ])),
+        foot,
+    );
+}
+
+fn line(pts: &[(f64, f64)], style: Style, marker: Marker) -> Dataset<'_> {
+    Dataset::default()
+        .data(pts)
+        .graph_type(GraphType::Line)
+        .marker(marker)
+        .style(style)
+}
+
+struct ChartData<'a> {
+    t: &'a [f64],
+    raw: &'a [f64],
+    cor: Option<&'a [f64]>,
+    range: Option<[f64; 2]>,
+    centroid: Option<f64>,
+    span: (f64, f64),
+    cursor: f64,
+    braille: bool,
+}
+
+fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
+    if area.height < 2 || area.width < 10 {
+        return;
+    }
+    let (s0, s1) = d.span;
+    let label_w = 5u16;
+    let cols = area.width.saturating_sub(label_w + 1).max(1) as usize;
+    let per_col = if d.braille { 2 } else { 1 };
+    let raw = envelope(d.t, d.raw, s0, s1, cols * per_col);
+    let cor = d
+        .cor
+        .map(|c| envelope(d.t, c, s0, s1, cols * per_col))
+        .unwrap_or_default();
+    // Bounds: the data in view and the limits.
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for &(_, y) in raw.iter().chain(cor.iter()) {
+        lo = lo.min(y);
+        hi = hi.max(y);
+    }
+    if let Some([a, b]) = d.range {
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    if !lo.is_finite() || !hi.is_finite() {
+        lo = -1.0;
+        hi = 1.0;
+    }
+    let pad = ((hi - lo) * 0.05).max(0.5);
+    let (lo, hi) = (lo - pad, hi + pad);
+    let lower: Vec<(f64, f64)>;
+    let upper: Vec<(f64, f64)>;
+    let centre: Vec<(f64, f64)>;
+    let cursor = vec![(d.cursor, lo), (d.cursor, hi)];
+    let marker = if d.braille {
+        Marker::Braille
+    } else {
+        Marker::Dot
+    };
+    // Limit lines first: a later dataset overwrites whole cells.
+    let mut sets = vec![];
+    if let Some([a, b]) = d.range {
+        lower = vec![(s0, a), (s1, a)];
+        upper = vec![(s0, b), (s1, b)];
+        sets.push(line(&lower, theme.limit, marker));
+        sets.push(line(&upper, theme.limit, marker));
+    }
+    if let Some(c) = d.centroid {
+        centre = vec![(s0, c), (s1, c)];
+        sets.push(line(&centre, theme.centroid, marker));
+    }
+    if d.cursor >= s0 && d.cursor <= s1 {
+        sets.push(line(&cursor, theme.cursor, marker));
+    }
+    sets.push(line(&raw, theme.raw, marker));
+    if !cor.is_empty() {
+        sets.push(line(&cor, theme.corrected, marker));
+    }
+    let y_labels = if area.height >= 7 {
+        vec![
+            format!("{lo:.0}"),
+            format!("{:.0}", (lo + hi) / 2.0),
+            format!("{hi:.0}"),
+        ]
+    } else {
+        vec![format!("{lo:.0}"), format!("{hi:.0}")]
+    };
+    let chart = Chart::new(sets)
+        .block(Block::new().borders(Borders::TOP).title(title))
+        .x_axis(Axis::default().bounds([s0, s1]))
+        .y_axis(
+            Axis::default()
+                .bounds([lo, hi])
+                .labels(y_labels)
+                .style(theme.dim),
+        )
+        .legend_position(None);
+    f.render_widget(chart, area);
+}
+
+fn figures_panel(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect, joint: &str) {
+    let before = figures_of(e.figures(None), joint);
+    let after = figures_of(e.figures(Some(app.variant)), joint);
+    let row = |label: &str, v: Option<[f64; 3]>| {
+        let mut s = format!("{label:<8}");
+        for k in 0..3 {
+            s.push_str(&num(v.map(|v| v[k]), 5));
+        }
+        Line::from(s)
+    };
+    let mut lines = vec![
+        Line::from(Span::styled(
+            format!("{:<8}{:>5}{:>5}{:>5}", app.variant.name(), "X", "Y", "Z"),
+            theme.header,
+        )),
+        row("out% b", before.map(|f| f.excursion.pct_outside)),
+        row("out% a", after.map(|f| f.excursion.pct_outside)),
+        row("exc b", before.map(|f| f.excursion.mean_excursion_deg)),
+        row("exc a", after.map(|f| f.excursion.mean_excursion_deg)),
+        row(
+            "shift",
+            after
+                .and_then(|f| f.shift.as_ref())
+                .map(|s| s.mean_shift_deg),
+        ),
+    ];
+    lines.push(Line::from(format!(
+        "{:<8}{}",
+        "corr deg",
+        num(
+            after
+                .and_then(|f| f.shift.as_ref())
+                .map(|s| s.mean_correction_angle_deg),
+            5
+        )
+    )));
+    f.render_widget(
+        Paragraph::new(lines).block(
+            Block::new()
+                .borders(Borders::TOP | Borders::RIGHT)
+                .title(" figures "),
+        ),
+        area,
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn envelope_keeps_spikes_and_bounds_points() {
+        let t: Vec<f64> = (0..1000).map(|i| i as f64 / 100.0).collect();
+        let mut y = vec![0.0; 1000];
+        y[503] = 50.0; // one-sample spike
+        y[700] = -20.0;
+        let e = envelope(&t, &y, 0.0, 10.0, 40);
+        assert!(e.len() <= 80, "{}", e.len());
+        assert!(e.iter().any(|&(_, v)| v == 50.0));
+        assert!(e.iter().any(|&(_, v)| v == -20.0));
+        assert!(e.windows(2).all(|w| w[0].0 <= w[1].0));
+        // Few samples: kept as they are, with a neighbour each side.
+        let e = envelope(&t, &y, 1.0, 1.05, 40);
+        assert_eq!(e.first().unwrap().0, 0.99);
+        assert_eq!(e.last().unwrap().0, 1.06);
+        assert!(envelope(&t, &y, 0.0, 10.0, 0).is_empty());
+        assert!(envelope(&[], &[], 0.0, 1.0, 10).is_empty());
+    }
+}

@@ -1,0 +1,134 @@
+//! The trials screen: every trial file of the folder, its status and figures.
+
+use super::app::{App, LoadState, TrialEntry};
+use super::render::{fit, num, sel};
+use super::theme::Theme;
+use crate::acm::Variant;
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
+use ratatui::Frame;
+
+/// Status of one variant of a trial, as shown.
+pub fn variant_status(e: &TrialEntry, v: Variant) -> String {
+    match e.results.get(&v) {
+        Some(r) if r.saved.is_some() => "saved".into(),
+        Some(_) if e.chosen == Some(v) => "chosen".into(),
+        _ if e.running.is_some() => format!("{}%", e.running.unwrap_or(0)),
+        Some(_) => "done".into(),
+        None => "-".into(),
+    }
+}
+
+pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+    let details_h = if area.height >= 16 { 5 } else { 0 };
+    let [list, details] =
+        Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area);
+    let fixed = 2 + 8 + 6 + 5 + 3 * 7 + 7 + 7;
+    let nw = (list.width as usize).saturating_sub(fixed).max(8);
+    let filter = if app.filter_editing || !app.filter.is_empty() {
+        format!(
+            "  filter /{}{}",
+            app.filter,
+            if app.filter_editing { "_" } else { "" }
+        )
+    } else {
+        String::new()
+    };
+    let mut lines = vec![Line::from(Span::styled(
+        format!(
+            "  {}{:>8}{:>6}{:>5}{:>7}{:>7}{:>7}{:>7}{:>7}",
+            fit(&format!("trial (sort: {}){filter}", app.sort.name()), nw),
+            "dur s",
+            "Hz",
+            "IMUs",
+            "basic",
+            "drift",
+            "d+c",
+            "exc",
+            app.variant.name().chars().take(6).collect::<String>(),
+        ),
+        theme.header,
+    ))];
+    let visible = app.visible();
+    let rows = list.height.saturating_sub(1) as usize;
+    let first = app.selected.saturating_sub(rows.saturating_sub(1));
+    for (k, &i) in visible.iter().enumerate().skip(first).take(rows) {
+        let e = &app.trials[i];
+        let selected = k == app.selected;
+        let marker = if selected { "> " } else { "  " };
+        let line = match &e.load {
+            LoadState::Pending => Line::from(vec![
+                Span::raw(format!("{marker}{}", fit(&e.file, nw))),
+                Span::styled("  loading...", theme.dim),
+            ]),
+            LoadState::Failed(m) => Line::from(vec![
+                Span::raw(format!("{marker}{}", fit(&e.file, nw))),
+                Span::styled(
+                    format!("  ERR {}", fit(m, fixed.saturating_sub(6))),
+                    theme.error,
+                ),
+            ]),
+            LoadState::Loaded(l) => {
+                let mut s = format!(
+                    "{marker}{}{:>8.1}{:>6.0}{:>5}",
+                    fit(&e.file, nw),
+                    l.trial.duration_s(),
+                    l.trial.rate_hz(),
+                    l.trial.imus.len()
+                );
+                for v in Variant::ALL {
+                    s.push_str(&format!("{:>7}", variant_status(e, v)));
+                }
+                s.push_str(&num(e.mean_excursion(None), 7));
+                s.push_str(&num(e.mean_excursion(Some(app.variant)), 7));
+                Line::from(s)
+            }
+        };
+        lines.push(line.style(sel(theme, selected)));
+    }
+    if visible.is_empty() {
+        lines.push(Line::from(Span::styled(
+            if app.trials.is_empty() {
+                format!("  no trial files in {}", app.dir_label)
+            } else {
+                "  no trial matches the filter".to_string()
+            },
+            theme.dim,
+        )));
+    }
+    f.render_widget(Paragraph::new(lines), list);
+    if details_h > 0 {
+        let mut text = vec![];
+        if let Some(e) = app.selected_entry() {
+            match &e.load {
+                LoadState::Loaded(l) => {
+                    let imus: Vec<&str> = l.trial.imus.iter().map(|i| i.name.as_str()).collect();
+                    text.push(Line::from(format!(
+                        "{} samples, model {}, IMUs: {}",
+                        l.trial.len(),
+                        l.model.name,
+                        imus.join(" ")
+                    )));
+                    if l.truth.is_some() {
+                        text.push(Line::from("truth beside the trial: RMS errors on compare"));
+                    }
+                    if let Some(m) = &l.truth_error {
+                        text.push(Line::from(Span::styled(format!("truth: {m}"), theme.warn)));
+                    }
+                    for w in &l.trial.warnings {
+                        text.push(Line::from(Span::styled(w.clone(), theme.warn)));
+                    }
+                }
+                LoadState::Failed(m) => text.push(Line::from(Span::styled(m.clone(), theme.error))),
+                LoadState::Pending => text.push(Line::from("loading...")),
+            }
+        }
+        f.render_widget(
+            Paragraph::new(text)
+                .wrap(Wrap { trim: true })
+                .block(Block::new().borders(Borders::TOP).title(" details ")),
+            details,
+        );
+    }
+}
