@@ -318,19 +318,19 @@ fn figures_panel(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: 
     let before = figures_of(e.figures(None), joint);
     let after = figures_of(e.figures(Some(app.variant)), joint);
     let row = |label: &str, v: Option<[f64; 3]>| {
-        let mut s = format!("{label:<8}");
+        let mut s = format!("{label:<6}");
         for k in 0..3 {
-            s.push_str(&num(v.map(|v| v[k]), 5));
+            s.push_str(&num(v.map(|v| v[k]), 6));
         }
         Line::from(s)
     };
     let mut lines = vec![
         Line::from(Span::styled(
-            format!("{:<8}{:>5}{:>5}{:>5}", app.variant.name(), "X", "Y", "Z"),
+            format!("{:<6}{:>6}{:>6}{:>6}", "deg", "X", "Y", "Z"),
             theme.header,
         )),
-        row("out% b", before.map(|f| f.excursion.pct_outside)),
-        row("out% a", after.map(|f| f.excursion.pct_outside)),
+        row("out%b", before.map(|f| f.excursion.pct_outside)),
+        row("out%a", after.map(|f| f.excursion.pct_outside)),
         row("exc b", before.map(|f| f.excursion.mean_excursion_deg)),
         row("exc a", after.map(|f| f.excursion.mean_excursion_deg)),
         row(
@@ -341,13 +341,13 @@ fn figures_panel(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: 
         ),
     ];
     lines.push(Line::from(format!(
-        "{:<8}{}",
-        "corr deg",
+        "{:<6}{}",
+        "corr",
         num(
             after
                 .and_then(|f| f.shift.as_ref())
                 .map(|s| s.mean_correction_angle_deg),
-            5
+            6
         )
     )));
     f.render_widget(
