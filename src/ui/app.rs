@@ -13,6 +13,25 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+/// Joint angles per joint of one trial (raw or corrected), computed the first
+/// time a screen asks: a 30-minute trial has 90,000 samples per joint, too many
+/// to convert on every frame.
+#[derive(Debug, Clone, Default)]
+pub struct AngleCache(Arc<std::sync::Mutex<BTreeMap<String, Arc<Vec<[f64; 3]>>>>>);
+
+impl AngleCache {
+    /// Z-Y-X angles (degrees) of `joint` in `trial`, cached by joint name.
+    pub fn get(&self, trial: &Trial, joint: &crate::model::Joint) -> Option<Arc<Vec<[f64; 3]>>> {
+        let mut map = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(a) = map.get(&joint.name) {
+            return Some(a.clone());
+        }
+        let a = Arc::new(crate::metrics::joint_angles(trial, joint)?);
+        map.insert(joint.name.clone(), a.clone());
+        Some(a)
+    }
+}
+
 /// A trial read from disk, with what the screens need of it.
 #[derive(Debug, Clone)]
 pub struct Loaded {
@@ -26,6 +45,8 @@ pub struct Loaded {
     pub truth_error: Option<String>,
     /// Figures of the uncorrected trial.
     pub before: Vec<JointFigures>,
+    /// Joint angles of the uncorrected trial, filled on demand.
+    pub angles: AngleCache,
 }
 
 /// Whether a trial is read yet.
@@ -40,6 +61,8 @@ pub enum LoadState {
 #[derive(Debug, Clone)]
 pub struct VariantResult {
     pub correction: Arc<Correction>,
+    /// Joint angles of the corrected trial, filled on demand.
+    pub angles: AngleCache,
     /// Where it was saved, relative to the trials folder.
     pub saved: Option<String>,
 }
@@ -716,6 +739,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                             c.variant,
                             VariantResult {
                                 correction: c,
+                                angles: AngleCache::default(),
                                 saved,
                             },
                         );

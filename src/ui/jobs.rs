@@ -129,6 +129,7 @@ pub fn load_trial(file: &str, path: &Path, limits: &LimitTable) -> Msg {
             truth,
             truth_error,
             before,
+            angles: Default::default(),
         }))
     })();
     Msg::Loaded(file.to_string(), result)

@@ -4,7 +4,7 @@ use super::app::{App, TrialEntry};
 use super::render::{fit, num, sel};
 use super::theme::Theme;
 use crate::limits::axis_name;
-use crate::metrics::{joint_angles, JointFigures};
+use crate::metrics::JointFigures;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Style;
 use ratatui::symbols::Marker;
@@ -140,11 +140,11 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(joint) = l.model.joint(&joint_name) else {
         return;
     };
-    let raw = joint_angles(&l.trial, joint).unwrap_or_default();
+    let raw = l.angles.get(&l.trial, joint).unwrap_or_default();
     let cor = e
         .results
         .get(&app.variant)
-        .and_then(|r| joint_angles(&r.correction.corrected, joint));
+        .and_then(|r| r.angles.get(&r.correction.corrected, joint));
     let lim = app
         .limits
         .table
