@@ -17,11 +17,14 @@ use std::sync::Arc;
 /// time a screen asks: a 30-minute trial has 90,000 samples per joint, too many
 /// to convert on every frame.
 #[derive(Debug, Clone, Default)]
-pub struct AngleCache(Arc<std::sync::Mutex<BTreeMap<String, Arc<Vec<[f64; 3]>>>>>);
+pub struct AngleCache(Arc<std::sync::Mutex<BTreeMap<String, JointAngles>>>);
+
+/// Z-Y-X angles `[x, y, z]` in degrees, one per sample, shared between frames.
+pub type JointAngles = Arc<Vec<[f64; 3]>>;
 
 impl AngleCache {
     /// Z-Y-X angles (degrees) of `joint` in `trial`, cached by joint name.
-    pub fn get(&self, trial: &Trial, joint: &crate::model::Joint) -> Option<Arc<Vec<[f64; 3]>>> {
+    pub fn get(&self, trial: &Trial, joint: &crate::model::Joint) -> Option<JointAngles> {
         let mut map = self.0.lock().unwrap_or_else(|p| p.into_inner());
         if let Some(a) = map.get(&joint.name) {
             return Some(a.clone());
