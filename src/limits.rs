@@ -160,6 +160,52 @@ impl SettingsFile {
     }
 }
 
+/// The limits of a folder such as `joint_limits/`: its `settings.toml` and the
+/// table that names, each from disk when present there, else the built-in copy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LimitsDir {
+    pub settings: SettingsFile,
+    pub table: LimitTable,
+    /// Where the table came from: its path, or `<built-in NAME>`.
+    pub table_source: String,
+}
+
+impl LimitsDir {
+    /// Resolves `dir/settings.toml` and the table it names, falling back to the
+    /// built-in files for whichever is absent. Malformed files are errors.
+    pub fn load(dir: &Path) -> Result<LimitsDir, LimitsError> {
+        let settings_path = dir.join("settings.toml");
+        let settings = if settings_path.exists() {
+            let origin = settings_path.display().to_string();
+            let text = std::fs::read_to_string(&settings_path).map_err(|e| LimitsError {
+                file: origin.clone(),
+                line: 0,
+                column: 0,
+                message: format!("cannot read: {e}"),
+            })?;
+            SettingsFile::parse(&text, &origin)?
+        } else {
+            SettingsFile::parse(BUILTIN_SETTINGS, "<built-in settings.toml>")?
+        };
+        let path = dir.join(&settings.table);
+        let (table, table_source) = if path.exists() {
+            (LimitTable::load(&path)?, path.display().to_string())
+        } else {
+            let (name, text) = BUILTIN_TABLES
+                .iter()
+                .find(|(n, _)| *n == settings.table)
+                .unwrap_or(&BUILTIN_TABLES[0]);
+            let source = format!("<built-in {name}>");
+            (LimitTable::parse(text, &source)?, source)
+        };
+        Ok(LimitsDir {
+            settings,
+            table,
+            table_source,
+        })
+    }
+}
+
 fn line_col(text: &str, offset: usize) -> (u64, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() as u64 + 1;
@@ -601,6 +647,28 @@ mod tests {
             .unwrap();
         let e = t.check_covers(&Model::infant13(), "s.csv").unwrap_err();
         assert!(e.message.contains("no row for joint 'back'"), "{e}");
+    }
+
+    #[test]
+    fn limits_dir_falls_back_to_built_ins_and_reads_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = LimitsDir::load(dir.path()).unwrap();
+        assert_eq!(d.table, LimitTable::default_table());
+        assert_eq!(d.table_source, "<built-in table_3_2.csv>");
+        std::fs::write(
+            dir.path().join("settings.toml"),
+            "table = \"mine.csv\"\nlambda1 = 0.1\nwindow_s = 40.0\nhop_s = 20.0\n",
+        )
+        .unwrap();
+        let mut mine = LimitTable::default_table();
+        mine.rows[0].upper_deg = 31.0;
+        std::fs::write(dir.path().join("mine.csv"), mine.to_csv()).unwrap();
+        let d = LimitsDir::load(dir.path()).unwrap();
+        assert_eq!((d.settings.lambda1, d.table.rows[0].upper_deg), (0.1, 31.0));
+        assert!(d.table_source.ends_with("mine.csv"));
+        std::fs::write(dir.path().join("mine.csv"), "joint,axis\n").unwrap();
+        let e = LimitsDir::load(dir.path()).unwrap_err();
+        assert!(e.file.ends_with("mine.csv") && e.line == 1, "{e}");
     }
 
     #[test]

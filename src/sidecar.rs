@@ -108,12 +108,13 @@ impl Sidecar {
         }
     }
 
-    /// The limit table recorded in the sidecar, checked against its hash.
-    pub fn table(&self) -> anyhow::Result<LimitTable> {
-        let t = LimitTable::parse(&self.limits.csv, "sidecar limits")?;
+    /// The limit table recorded in the sidecar, checked against its hash;
+    /// `origin` (the sidecar's path) names it in errors.
+    pub fn table(&self, origin: &str) -> anyhow::Result<LimitTable> {
+        let t = LimitTable::parse(&self.limits.csv, &format!("{origin} (limits.csv)"))?;
         anyhow::ensure!(
             t.hash() == self.limits.sha256,
-            "the sidecar's limit table does not match its recorded hash"
+            "{origin}: limits.csv does not match limits.sha256 (the sidecar was edited?)"
         );
         Ok(t)
     }
@@ -135,11 +136,6 @@ impl Sidecar {
                 e.column()
             )
         })
-    }
-
-    /// The variant's name (for display).
-    pub fn variant_name(&self) -> &'static str {
-        Variant::name(self.variant)
     }
 }
 

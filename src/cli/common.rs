@@ -1,9 +1,8 @@
 //! What several commands share: model, limits and settings resolution, progress.
 
-use acm_workbench::limits::{LimitTable, Settings, SettingsFile, BUILTIN_SETTINGS, BUILTIN_TABLES};
-use acm_workbench::model::{Model, BUILTIN_MODELS};
-use acm_workbench::trial::read_trial_header;
-use anyhow::Context as _;
+use acm_workbench::limits::{LimitTable, LimitsDir, Settings};
+use acm_workbench::model::Model;
+use acm_workbench::trial::detect_model;
 use clap::Args;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -33,6 +32,16 @@ pub struct EngineArgs {
     pub threads: Option<usize>,
 }
 
+/// Sizes the global worker pool (all cores when `None`). Results do not
+/// depend on it; a pool that already exists is kept.
+pub fn set_threads(threads: Option<usize>) {
+    if let Some(n) = threads {
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
+    }
+}
+
 /// Model, limits and settings for a run.
 pub struct Context {
     pub model: Model,
@@ -45,21 +54,6 @@ pub struct Context {
 /// The folder of limit tables the program uses when none is named: `./joint_limits`.
 pub fn default_limits_dir() -> PathBuf {
     PathBuf::from("joint_limits")
-}
-
-/// Picks the built-in model that recognises most IMUs of the trial.
-pub fn detect_model(trial: &Path) -> Model {
-    let mut best: Option<(usize, Model)> = None;
-    for (name, _) in BUILTIN_MODELS {
-        let model = Model::builtin(name).expect("built-in model is valid");
-        let known = read_trial_header(trial, &model)
-            .map(|h| h.imus.iter().filter(|i| model.imus.contains(i)).count())
-            .unwrap_or(0);
-        if best.as_ref().is_none_or(|(k, _)| known > *k) {
-            best = Some((known, model));
-        }
-    }
-    best.expect("there are built-in models").1
 }
 
 /// Resolves model, limit table and settings from the arguments.
@@ -75,33 +69,13 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
         (None, Some(t)) => detect_model(t),
         (None, None) => Model::infant13(),
     };
-    let dir = default_limits_dir();
-    let settings_path = dir.join("settings.toml");
-    let file_settings = if settings_path.exists() {
-        let text = std::fs::read_to_string(&settings_path)
-            .with_context(|| format!("{}: cannot read", settings_path.display()))?;
-        SettingsFile::parse(&text, &settings_path.display().to_string())?
-    } else {
-        SettingsFile::parse(BUILTIN_SETTINGS, "<built-in settings.toml>")?
-    };
+    let dir = LimitsDir::load(&default_limits_dir())?;
     let (limits, limits_source) = match &args.limits {
         Some(p) => (LimitTable::load(p)?, p.display().to_string()),
-        None => {
-            let p = dir.join(&file_settings.table);
-            if p.exists() {
-                (LimitTable::load(&p)?, p.display().to_string())
-            } else {
-                let (name, text) = BUILTIN_TABLES
-                    .iter()
-                    .find(|(n, _)| *n == file_settings.table)
-                    .unwrap_or(&BUILTIN_TABLES[0]);
-                let source = format!("<built-in {name}>");
-                (LimitTable::parse(text, &source)?, source)
-            }
-        }
+        None => (dir.table, dir.table_source),
     };
     limits.check_covers(&model, &limits_source)?;
-    let defaults = file_settings.settings();
+    let defaults = dir.settings.settings();
     let settings = Settings {
         lambda1: args.lambda1.unwrap_or(defaults.lambda1),
         window_s: args.window.unwrap_or(defaults.window_s),

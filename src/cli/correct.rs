@@ -1,6 +1,6 @@
 //! `acmw correct`: correct a trial, write the corrected trial and its sidecar.
 
-use super::common::{load_context, Context, EngineArgs, Progress};
+use super::common::{load_context, set_threads, Context, EngineArgs, Progress};
 use acm_workbench::acm::{correct_trial, RunControl, Variant};
 use acm_workbench::sidecar::{default_output, SaveRequest, Sidecar};
 use acm_workbench::trial::{detect_format, read_trial, TrialFormat};
@@ -39,12 +39,8 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     let (ctx, variant) = match &args.from_sidecar {
         Some(p) => {
             let s = Sidecar::load(p)?;
-            let limits = s.table()?;
-            if let Some(n) = args.engine.threads {
-                let _ = rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build_global();
-            }
+            let limits = s.table(&p.display().to_string())?;
+            set_threads(args.engine.threads);
             let ctx = Context {
                 model: s.model.clone(),
                 limits,

@@ -90,6 +90,23 @@ impl Trial {
     }
 }
 
+/// The built-in model that recognises most IMUs of the trial at `path` (from
+/// its header only); the first built-in model when none recognises any.
+pub fn detect_model(path: &std::path::Path) -> crate::model::Model {
+    use crate::model::{Model, BUILTIN_MODELS};
+    let mut best: Option<(usize, Model)> = None;
+    for (name, _) in BUILTIN_MODELS {
+        let model = Model::builtin(name).expect("built-in model is valid");
+        let known = read_trial_header(path, &model)
+            .map(|h| h.imus.iter().filter(|i| model.imus.contains(i)).count())
+            .unwrap_or(0);
+        if best.as_ref().is_none_or(|(k, _)| known > *k) {
+            best = Some((known, model));
+        }
+    }
+    best.expect("there are built-in models").1
+}
+
 /// Median of the differences of consecutive times (0 for fewer than two).
 pub fn median_dt(time_s: &[f64]) -> f64 {
     if time_s.len() < 2 {

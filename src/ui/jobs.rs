@@ -4,12 +4,11 @@
 
 use super::app::{update, App, Effect, LimitsState, Loaded, Msg, RunJob};
 use crate::acm::{correct_trial, recorrect, Correction, RunControl, Variant};
-use crate::limits::{LimitTable, SettingsFile, BUILTIN_SETTINGS, BUILTIN_TABLES};
+use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
-use crate::model::{Model, BUILTIN_MODELS};
 use crate::report::ReportInput;
 use crate::sidecar::{default_output, SaveRequest};
-use crate::trial::{detect_format, is_trial_file, read_trial, read_trial_header, TrialError};
+use crate::trial::{detect_format, detect_model, is_trial_file, read_trial, TrialError};
 use crate::truth::load_truth_beside;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -30,58 +29,17 @@ pub fn list_trials(dir: &Path) -> Result<Vec<String>, String> {
     Ok(names)
 }
 
-/// The built-in model that recognises most IMUs of the trial (as `acmw correct`).
-pub fn detect_model(path: &Path) -> Model {
-    let mut best: Option<(usize, Model)> = None;
-    for (name, _) in BUILTIN_MODELS {
-        let model = Model::builtin(name).expect("built-in model is valid");
-        let known = read_trial_header(path, &model)
-            .map(|h| h.imus.iter().filter(|i| model.imus.contains(i)).count())
-            .unwrap_or(0);
-        if best.as_ref().is_none_or(|(k, _)| known > *k) {
-            best = Some((known, model));
-        }
-    }
-    best.expect("there are built-in models").1
-}
-
 /// The limits the workbench edits: `dir/settings.toml` and the table it names,
 /// or the built-in ones when `dir` (normally `./joint_limits`) does not have them;
 /// saving creates them there. Resolved as the command-line tools do.
 pub fn load_limits(dir: &Path) -> Result<LimitsState, String> {
-    let settings_path = dir.join("settings.toml");
-    let settings = if settings_path.exists() {
-        let text = std::fs::read_to_string(&settings_path)
-            .map_err(|e| format!("{}: cannot read: {e}", settings_path.display()))?;
-        SettingsFile::parse(&text, &settings_path.display().to_string())
-            .map_err(|e| e.to_string())?
-    } else {
-        SettingsFile::parse(BUILTIN_SETTINGS, "<built-in settings.toml>")
-            .map_err(|e| e.to_string())?
-    };
-    let p = dir.join(&settings.table);
-    let (table, source) = if p.exists() {
-        (
-            LimitTable::load(&p).map_err(|e| e.to_string())?,
-            p.display().to_string(),
-        )
-    } else {
-        let (name, text) = BUILTIN_TABLES
-            .iter()
-            .find(|(n, _)| *n == settings.table)
-            .unwrap_or(&BUILTIN_TABLES[0]);
-        let source = format!("<built-in {name}>");
-        (
-            LimitTable::parse(text, &source).map_err(|e| e.to_string())?,
-            source,
-        )
-    };
+    let d = LimitsDir::load(dir).map_err(|e| e.to_string())?;
     Ok(LimitsState::new(
         dir.to_path_buf(),
-        settings.table.clone(),
-        source,
-        table,
-        settings,
+        d.settings.table.clone(),
+        d.table_source,
+        d.table,
+        d.settings,
     ))
 }
 
