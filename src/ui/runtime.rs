@@ -113,6 +113,28 @@ type Watcher = notify_debouncer_full::Debouncer<
     notify_debouncer_full::RecommendedCache,
 >;
 
+/// Paths whose content, name or existence changed. Reading a file (ours
+/// included) raises access events and metadata changes touch no content:
+/// neither counts, or every read would trigger a reload.
+fn changed_paths(
+    events: &[notify_debouncer_full::DebouncedEvent],
+) -> impl Iterator<Item = &PathBuf> {
+    use notify::event::{EventKind, ModifyKind};
+    events
+        .iter()
+        .filter(|e| {
+            matches!(
+                e.kind,
+                EventKind::Create(_)
+                    | EventKind::Remove(_)
+                    | EventKind::Modify(
+                        ModifyKind::Data(_) | ModifyKind::Name(_) | ModifyKind::Any
+                    )
+            )
+        })
+        .flat_map(|e| e.paths.iter())
+}
+
 /// Watches the trials folder (non-recursive): changed and removed trial files.
 fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
     let d = dir.to_path_buf();
@@ -121,23 +143,9 @@ fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
         None,
         move |r: DebounceEventResult| {
             let Ok(events) = r else { return };
-            // Reading a file (ours included) raises access events: only
-            // creations, content changes, renames and removals count.
-            let paths: BTreeSet<PathBuf> = events
-                .iter()
-                .filter(|e| {
-                    use notify::event::{EventKind, ModifyKind};
-                    matches!(
-                        e.kind,
-                        EventKind::Create(_)
-                            | EventKind::Remove(_)
-                            | EventKind::Modify(
-                                ModifyKind::Data(_) | ModifyKind::Name(_) | ModifyKind::Any
-                            )
-                    )
-                })
-                .flat_map(|e| e.paths.iter().cloned())
+            let paths: BTreeSet<PathBuf> = changed_paths(&events)
                 .filter(|p| is_trial_file(p))
+                .cloned()
                 .collect();
             for p in paths {
                 let Some(name) = p.file_name().map(|n| n.to_string_lossy().into_owned()) else {
@@ -169,14 +177,10 @@ fn watch_limits(dir: &Path, table: String, tx: Sender<Event>) -> Option<Watcher>
         None,
         move |r: DebounceEventResult| {
             let Ok(events) = r else { return };
-            let relevant = events
-                .iter()
-                .filter(|e| !matches!(e.kind, notify::EventKind::Access(_)))
-                .flat_map(|e| e.paths.iter())
-                .any(|p| {
-                    p.file_name()
-                        .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
-                });
+            let relevant = changed_paths(&events).any(|p| {
+                p.file_name()
+                    .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
+            });
             if relevant {
                 if let Some((t, s)) = read_limits_on_disk(&d, &table) {
                     let _ = tx.send(Event::Msg(Msg::LimitsOnDisk(t, s)));
