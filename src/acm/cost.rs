@@ -13,21 +13,22 @@
 use crate::limits::JointLimits;
 use crate::rotation::{angle_deg, euler_zyx_deg, quat_from_euler_zyx_deg, Quat};
 
+/// Excursion of one angle `a` beyond `[lo, hi]` (degrees): `a - hi` above,
+/// `lo - a` below, 0 inside.
+#[inline(always)]
+pub fn beyond(a: f64, lo: f64, hi: f64) -> f64 {
+    if a > hi {
+        a - hi
+    } else if a < lo {
+        lo - a
+    } else {
+        0.0
+    }
+}
+
 /// Per-sample excursion of angles `[x, y, z]` (degrees) beyond `[lo, hi]` per axis.
 pub fn excursion(angles_deg: [f64; 3], range_deg: &[[f64; 2]; 3]) -> [f64; 3] {
-    let mut e = [0.0; 3];
-    for axis in 0..3 {
-        let a = angles_deg[axis];
-        let [lo, hi] = range_deg[axis];
-        e[axis] = if a > hi {
-            a - hi
-        } else if a < lo {
-            lo - a
-        } else {
-            0.0
-        };
-    }
-    e
+    std::array::from_fn(|axis| beyond(angles_deg[axis], range_deg[axis][0], range_deg[axis][1]))
 }
 
 /// Sign-invariant Euclidean distance between unit quaternions (eq. 3.17-3.21):
@@ -101,14 +102,7 @@ impl ArcRange {
         if inside && (s != 0.0 || c != 0.0) {
             return 0.0;
         }
-        let a = s.atan2(c).to_degrees();
-        if a > self.hi {
-            a - self.hi
-        } else if a < self.lo {
-            self.lo - a
-        } else {
-            0.0
-        }
+        beyond(s.atan2(c).to_degrees(), self.lo, self.hi)
     }
 }
 
@@ -152,14 +146,7 @@ impl PitchRange {
         if r20 <= self.r20_max && r20 >= self.r20_min {
             return 0.0;
         }
-        let a = -r20.clamp(-1.0, 1.0).asin().to_degrees();
-        if a > self.hi {
-            a - self.hi
-        } else if a < self.lo {
-            self.lo - a
-        } else {
-            0.0
-        }
+        beyond(-r20.clamp(-1.0, 1.0).asin().to_degrees(), self.lo, self.hi)
     }
 }
 
