@@ -9,8 +9,11 @@ use acm_workbench::trial::{write_trial, TrialFormat};
 use acm_workbench::ui::app::App;
 use acm_workbench::ui::headless::{draw, load_app, show, Show};
 use acm_workbench::ui::jobs::{list_trials, load_limits};
+use acm_workbench::ui::render::render;
 use acm_workbench::ui::theme::Theme;
 use criterion::{criterion_group, criterion_main, Criterion};
+use ratatui::backend::TestBackend;
+use ratatui::Terminal;
 use std::path::Path;
 
 fn benches(c: &mut Criterion) {
@@ -31,7 +34,13 @@ fn benches(c: &mut Criterion) {
         variant: None,
     };
     show(&mut app, &s).unwrap();
+    // A frame as the runtime draws it: one terminal kept across frames.
+    let mut term = Terminal::new(TestBackend::new(200, 60)).unwrap();
     c.bench_function("draw trial screen, 30 min trial, 200x60", |b| {
+        b.iter(|| term.draw(|f| render(&app, &theme, f)).map(|_| ()).unwrap())
+    });
+    // The same through `acmw render`'s path (a new terminal and buffer each time).
+    c.bench_function("render trial screen to a new buffer, 200x60", |b| {
         b.iter(|| draw(&app, &theme, 200, 60))
     });
 

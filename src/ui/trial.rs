@@ -12,52 +12,58 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
 use ratatui::Frame;
 
-/// Reduces the samples of `y` (at times `t`, ascending) inside `[t0, t1]` to at
-/// most two points per column of `columns`: the minimum and the maximum of the
-/// column, so that spikes stay visible. Fewer samples than columns are returned
-/// as they are (plus one neighbour each side, so lines reach the edges).
-pub fn envelope(t: &[f64], y: &[f64], t0: f64, t1: f64, columns: usize) -> Vec<(f64, f64)> {
-    let n = t.len().min(y.len());
+/// Reduces the samples `y(i)` at times `t[i] - origin` (ascending) inside
+/// `[t0, t1]` to at most two points per column of `columns`: the minimum and the
+/// maximum of the column, so that spikes stay visible. Fewer samples than
+/// columns are returned as they are (plus one neighbour each side, so lines
+/// reach the edges). Reads the samples in place: only the visible ones are
+/// touched, and nothing of the trial's length is allocated.
+pub fn envelope(
+    t: &[f64],
+    origin: f64,
+    y: impl Fn(usize) -> f64,
+    t0: f64,
+    t1: f64,
+    columns: usize,
+) -> Vec<(f64, f64)> {
+    let n = t.len();
     if n == 0 || columns == 0 || t1 <= t0 {
         return vec![];
     }
-    let a = t[..n].partition_point(|&x| x < t0).saturating_sub(1);
-    let b = (t[..n].partition_point(|&x| x <= t1) + 1).min(n);
+    let a = t.partition_point(|&x| x - origin < t0).saturating_sub(1);
+    let b = (t.partition_point(|&x| x - origin <= t1) + 1).min(n);
     if b - a <= 2 * columns {
-        return (a..b).map(|i| (t[i], y[i])).collect();
+        return (a..b).map(|i| (t[i] - origin, y(i))).collect();
     }
     let w = (t1 - t0) / columns as f64;
     let mut out = Vec::with_capacity(2 * columns);
-    let mut col = usize::MAX;
-    let (mut lo, mut hi) = (0.0f64, 0.0f64);
-    let flush = |col: usize, lo: f64, hi: f64, out: &mut Vec<(f64, f64)>| {
-        let tc = t0 + (col as f64 + 0.5) * w;
-        out.push((tc, lo));
-        if hi != lo {
-            out.push((tc, hi));
-        }
-    };
-    for i in a..b {
-        let c = (((t[i] - t0) / w).floor().max(0.0) as usize).min(columns - 1);
-        if c != col {
-            if col != usize::MAX {
-                flush(col, lo, hi, &mut out);
-            }
-            col = c;
-            lo = y[i];
-            hi = y[i];
+    // Times ascend, so each column is a run of samples found by binary search;
+    // the first column also takes the neighbour before t0, the last the one after t1.
+    let mut start = a;
+    for col in 0..columns {
+        let end = if col + 1 == columns {
+            b
         } else {
-            lo = lo.min(y[i]);
-            hi = hi.max(y[i]);
+            let edge = t0 + (col + 1) as f64 * w;
+            start + t[start..b].partition_point(|&x| x - origin < edge)
+        };
+        if end > start {
+            let (lo, hi) = (start..end).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), k| {
+                let v = y(k);
+                (lo.min(v), hi.max(v))
+            });
+            let tc = t0 + (col as f64 + 0.5) * w;
+            out.push((tc, lo));
+            if hi != lo {
+                out.push((tc, hi));
+            }
         }
-    }
-    if col != usize::MAX {
-        flush(col, lo, hi, &mut out);
+        start = end;
     }
     out
 }
 
-/// The sample index nearest to `ts`.
+/// The sample index nearest to `ts` (times `t` already relative).
 fn index_at(t: &[f64], ts: f64) -> usize {
     let i = t.partition_point(|&x| x < ts);
     if i == 0 {
@@ -149,16 +155,14 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         .limits
         .table
         .joint_limits(&joint.name, &joint.kind, true);
-    let t0 = l.trial.time_s.first().copied().unwrap_or(0.0);
-    let t: Vec<f64> = l.trial.time_s.iter().map(|x| x - t0).collect();
+    let t = &l.trial.time_s;
+    let origin = t.first().copied().unwrap_or(0.0);
     let d = l.trial.duration_s();
     let (s0, s1) = app.view.span(d);
-    let ci = index_at(&t, app.view.cursor_s);
+    let ci = index_at(t, app.view.cursor_s + origin);
     let [charts, foot] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
     let parts = Layout::vertical([Constraint::Ratio(1, 3); 3]).split(charts);
     for axis in 0..3 {
-        let y_raw: Vec<f64> = raw.iter().map(|a| a[axis]).collect();
-        let y_cor: Option<Vec<f64>> = cor.as_ref().map(|c| c.iter().map(|a| a[axis]).collect());
         let range = lim.map(|l| l.range_deg[axis]);
         let centroid = lim.and_then(|l| l.centroid_deg).map(|c| c[axis]);
         let mut title = vec![Span::styled(format!(" {} ", axis_name(axis)), theme.header)];
@@ -169,12 +173,12 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             title.push(Span::styled(format!("c {c} "), theme.centroid));
         }
         title.push(Span::styled(
-            format!("raw {} ", num(y_raw.get(ci).copied(), 0)),
+            format!("raw {} ", num(raw.get(ci).map(|a| a[axis]), 0)),
             theme.raw,
         ));
-        if let Some(yc) = &y_cor {
+        if let Some(c) = &cor {
             title.push(Span::styled(
-                format!("{} {} ", app.variant, num(yc.get(ci).copied(), 0)),
+                format!("{} {} ", app.variant, num(c.get(ci).map(|a| a[axis]), 0)),
                 theme.corrected,
             ));
         }
@@ -184,9 +188,11 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             theme,
             Line::from(title),
             ChartData {
-                t: &t,
-                raw: &y_raw,
-                cor: y_cor.as_deref(),
+                t,
+                origin,
+                axis,
+                raw: &raw,
+                cor: cor.as_deref().map(Vec::as_slice),
                 range,
                 centroid,
                 span: (s0, s1),
@@ -224,9 +230,13 @@ fn line(pts: &[(f64, f64)], style: Style, marker: Marker) -> Dataset<'_> {
 }
 
 struct ChartData<'a> {
+    /// Sample times as recorded; the chart's time axis starts at `origin`.
     t: &'a [f64],
-    raw: &'a [f64],
-    cor: Option<&'a [f64]>,
+    origin: f64,
+    /// Which angle of `raw` and `cor` to draw (0 = X).
+    axis: usize,
+    raw: &'a [[f64; 3]],
+    cor: Option<&'a [[f64; 3]]>,
     range: Option<[f64; 2]>,
     centroid: Option<f64>,
     span: (f64, f64),
@@ -242,10 +252,10 @@ fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
     let label_w = 5u16;
     let cols = area.width.saturating_sub(label_w + 1).max(1) as usize;
     let per_col = if d.braille { 2 } else { 1 };
-    let raw = envelope(d.t, d.raw, s0, s1, cols * per_col);
+    let raw = envelope(d.t, d.origin, |i| d.raw[i][d.axis], s0, s1, cols * per_col);
     let cor = d
         .cor
-        .map(|c| envelope(d.t, c, s0, s1, cols * per_col))
+        .map(|c| envelope(d.t, d.origin, |i| c[i][d.axis], s0, s1, cols * per_col))
         .unwrap_or_default();
     // Bounds: the data in view and the limits.
     let mut lo = f64::INFINITY;
@@ -370,16 +380,24 @@ mod tests {
         let mut y = vec![0.0; 1000];
         y[503] = 50.0; // one-sample spike
         y[700] = -20.0;
-        let e = envelope(&t, &y, 0.0, 10.0, 40);
+        let e = envelope(&t, 0.0, |i| y[i], 0.0, 10.0, 40);
         assert!(e.len() <= 80, "{}", e.len());
         assert!(e.iter().any(|&(_, v)| v == 50.0));
         assert!(e.iter().any(|&(_, v)| v == -20.0));
         assert!(e.windows(2).all(|w| w[0].0 <= w[1].0));
         // Few samples: kept as they are, with a neighbour each side.
-        let e = envelope(&t, &y, 1.0, 1.05, 40);
+        let e = envelope(&t, 0.0, |i| y[i], 1.0, 1.05, 40);
         assert_eq!(e.first().unwrap().0, 0.99);
         assert_eq!(e.last().unwrap().0, 1.06);
-        assert!(envelope(&t, &y, 0.0, 10.0, 0).is_empty());
-        assert!(envelope(&[], &[], 0.0, 1.0, 10).is_empty());
+        assert!(envelope(&t, 0.0, |i| y[i], 0.0, 10.0, 0).is_empty());
+        assert!(envelope(&[], 0.0, |_| 0.0, 0.0, 1.0, 10).is_empty());
+        // Times recorded from 100 s, drawn from the origin: the same envelope.
+        let late: Vec<f64> = t.iter().map(|x| x + 100.0).collect();
+        let shifted = envelope(&late, 100.0, |i| y[i], 0.0, 10.0, 40);
+        let plain = envelope(&t, 0.0, |i| y[i], 0.0, 10.0, 40);
+        assert_eq!(shifted.len(), plain.len());
+        for (a, b) in shifted.iter().zip(&plain) {
+            assert!((a.0 - b.0).abs() < 1e-9 && a.1 == b.1);
+        }
     }
 }
