@@ -135,29 +135,18 @@ fn changed_paths(
         .flat_map(|e| e.paths.iter())
 }
 
-/// Watches the trials folder (non-recursive): changed and removed trial files.
-fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
-    let d = dir.to_path_buf();
+/// Watches `dir` (non-recursive, debounced 250 ms) and hands each batch of
+/// content changes ([`changed_paths`]) to `on_change`.
+fn watch_folder(dir: &Path, on_change: impl Fn(Vec<PathBuf>) + Send + 'static) -> Option<Watcher> {
     let mut w = new_debouncer(
         Duration::from_millis(250),
         None,
         move |r: DebounceEventResult| {
-            let Ok(events) = r else { return };
-            let paths: BTreeSet<PathBuf> = changed_paths(&events)
-                .filter(|p| is_trial_file(p))
-                .cloned()
-                .collect();
-            for p in paths {
-                let Some(name) = p.file_name().map(|n| n.to_string_lossy().into_owned()) else {
-                    continue;
-                };
-                let path = d.join(&name);
-                let msg = if path.is_file() {
-                    Msg::FileChanged(name, path)
-                } else {
-                    Msg::FileRemoved(name)
-                };
-                let _ = tx.send(Event::Msg(msg));
+            if let Ok(events) = r {
+                let paths: Vec<PathBuf> = changed_paths(&events).cloned().collect();
+                if !paths.is_empty() {
+                    on_change(paths);
+                }
             }
         },
     )
@@ -166,31 +155,44 @@ fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
     Some(w)
 }
 
+/// Watches the trials folder: changed and removed trial files.
+fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
+    let d = dir.to_path_buf();
+    watch_folder(dir, move |paths| {
+        let names: BTreeSet<String> = paths
+            .iter()
+            .filter(|p| is_trial_file(p))
+            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .collect();
+        for name in names {
+            let path = d.join(&name);
+            let msg = if path.is_file() {
+                Msg::FileChanged(name, path)
+            } else {
+                Msg::FileRemoved(name)
+            };
+            let _ = tx.send(Event::Msg(msg));
+        }
+    })
+}
+
 /// Watches the limits folder: a changed table or settings file is re-read.
 fn watch_limits(dir: &Path, table: String, tx: Sender<Event>) -> Option<Watcher> {
     if !dir.is_dir() {
         return None;
     }
     let d = dir.to_path_buf();
-    let mut w = new_debouncer(
-        Duration::from_millis(250),
-        None,
-        move |r: DebounceEventResult| {
-            let Ok(events) = r else { return };
-            let relevant = changed_paths(&events).any(|p| {
-                p.file_name()
-                    .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
-            });
-            if relevant {
-                if let Some((t, s)) = read_limits_on_disk(&d, &table) {
-                    let _ = tx.send(Event::Msg(Msg::LimitsOnDisk(t, s)));
-                }
+    watch_folder(dir, move |paths| {
+        let relevant = paths.iter().any(|p| {
+            p.file_name()
+                .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
+        });
+        if relevant {
+            if let Some((t, s)) = read_limits_on_disk(&d, &table) {
+                let _ = tx.send(Event::Msg(Msg::LimitsOnDisk(t, s)));
             }
-        },
-    )
-    .ok()?;
-    w.watch(dir, RecursiveMode::NonRecursive).ok()?;
-    Some(w)
+        }
+    })
 }
 
 struct Workers {
