@@ -16,3 +16,4 @@ pub mod simulate;
 pub mod trial;
 pub mod truth;
 pub mod ui;
+pub mod vertical;

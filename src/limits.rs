@@ -15,6 +15,7 @@
 //! `joint_limits/settings.toml` (see [`Settings`]).
 
 use crate::model::Model;
+use crate::vertical::Vertical;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -101,6 +102,9 @@ pub struct Settings {
     pub window_s: f64,
     /// Hop between window starts, seconds.
     pub hop_s: f64,
+    /// The global frame's up axis (heading-drift variants turn about it).
+    #[serde(default)]
+    pub vertical: Vertical,
 }
 
 impl Default for Settings {
@@ -109,6 +113,7 @@ impl Default for Settings {
             lambda1: 0.05,
             window_s: 60.0,
             hop_s: 30.0,
+            vertical: Vertical::ZUp,
         }
     }
 }
@@ -121,6 +126,9 @@ pub struct SettingsFile {
     pub lambda1: f64,
     pub window_s: f64,
     pub hop_s: f64,
+    /// `z-up` (default) or `z-down` (north-east-down recordings).
+    #[serde(default)]
+    pub vertical: Vertical,
 }
 
 impl SettingsFile {
@@ -148,14 +156,15 @@ impl SettingsFile {
             lambda1: self.lambda1,
             window_s: self.window_s,
             hop_s: self.hop_s,
+            vertical: self.vertical,
         }
     }
 
     /// TOML text for saving.
     pub fn to_toml(&self) -> String {
         format!(
-            "# Correction settings (METHOD.md sections 3-4); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n",
-            self.table, self.lambda1, self.window_s, self.hop_s
+            "# Correction settings (METHOD.md sections 3-4); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n",
+            self.table, self.lambda1, self.window_s, self.hop_s, self.vertical.name()
         )
     }
 }

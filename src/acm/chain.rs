@@ -6,10 +6,12 @@
 //! is bit-identical for any thread count.
 
 use super::cost::WindowCost;
+use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
 use super::minimise::{minimise, MinimiseOptions, Solution};
 use super::window::{correction_series, layout, whole_trial, Window};
 use super::{
-    Cancelled, Correction, JointResult, RunControl, SkippedJoint, Variant, WindowSolution,
+    Cancelled, Correction, HeadingWindow, ImuHeading, JointResult, RunControl, SkippedJoint,
+    Variant, WindowSolution,
 };
 use crate::limits::{JointLimits, LimitTable, Settings};
 use crate::model::{Joint, Model};
@@ -124,11 +126,12 @@ fn run(
     let done = AtomicUsize::new(0);
     let depths = model.joint_depths();
     let mut results: HashMap<usize, JointResult> = HashMap::new();
+    let mut headings: HashMap<usize, ImuHeading> = HashMap::new();
     let max_depth = depths.iter().copied().max().unwrap_or(0);
     for depth in 0..=max_depth {
         let level: Vec<&(usize, JointLimits)> =
             todo.iter().filter(|(k, _)| depths[*k] == depth).collect();
-        let solved: Vec<(usize, JointResult, Applied)> = level
+        let solved: Vec<(usize, JointResult, Applied, Option<ImuHeading>)> = level
             .par_iter()
             .map(|(k, lim)| {
                 let joint = &model.joints[*k];
@@ -137,23 +140,50 @@ fn run(
                     if !redo.contains(k) {
                         if let Some(r) = prev.joint(&joint.name) {
                             let kept = prev.corrected.imu(&joint.distal).expect("present");
-                            return Ok((*k, r.clone(), Applied::Kept(kept.orientation.clone())));
+                            let heading = prev.heading(&joint.distal).cloned();
+                            let applied = Applied::Kept(kept.orientation.clone());
+                            return Ok((*k, r.clone(), applied, heading));
                         }
                     }
                 }
                 let parent = &corrected.imu(&joint.proximal).expect("present").orientation;
                 let child = &trial.imu(&joint.distal).expect("present").orientation;
-                let measured: Vec<Quat> = parent
-                    .iter()
-                    .zip(child)
-                    .map(|(p, c)| p.inverse() * c)
-                    .collect();
                 let progress = || {
                     let d = done.fetch_add(1, Ordering::Relaxed) + 1;
                     if let Some(p) = control.progress {
                         p(d, total);
                     }
                 };
+                let result = |windows| JointResult {
+                    joint: joint.name.clone(),
+                    proximal: joint.proximal.clone(),
+                    distal: joint.distal.clone(),
+                    lambda2: lim.lambda2,
+                    parent_corrected,
+                    windows,
+                };
+                if variant.heading() {
+                    if control.cancelled() {
+                        return Err(Cancelled);
+                    }
+                    let problem = HeadingProblem {
+                        parent,
+                        child,
+                        windows: &windows,
+                        limits: lim,
+                        lambda1: settings.lambda1,
+                        vertical: settings.vertical,
+                    };
+                    let (sol, heading, orientation) =
+                        solve_heading(&trial.time_s, &problem, &joint.name, &joint.distal);
+                    windows.iter().for_each(|_| progress());
+                    return Ok((*k, result(sol), Applied::Kept(orientation), Some(heading)));
+                }
+                let measured: Vec<Quat> = parent
+                    .iter()
+                    .zip(child)
+                    .map(|(p, c)| p.inverse() * c)
+                    .collect();
                 let sol = solve_windows(
                     &trial.time_s,
                     &measured,
@@ -163,18 +193,13 @@ fn run(
                     control,
                     &progress,
                 )?;
-                let result = JointResult {
-                    joint: joint.name.clone(),
-                    proximal: joint.proximal.clone(),
-                    distal: joint.distal.clone(),
-                    lambda2: lim.lambda2,
-                    parent_corrected,
-                    windows: sol.windows,
-                };
-                Ok((*k, result, Applied::Series(sol.series)))
+                Ok((*k, result(sol.windows), Applied::Series(sol.series), None))
             })
             .collect::<Result<_, Cancelled>>()?;
-        for (k, result, applied) in solved {
+        for (k, result, applied, heading) in solved {
+            if let Some(h) = heading {
+                headings.insert(k, h);
+            }
             let distal = &model.joints[k].distal;
             let imu = corrected.imu_mut(distal).expect("present");
             match applied {
@@ -190,7 +215,10 @@ fn run(
     }
     let mut joints: Vec<(usize, JointResult)> = results.into_iter().collect();
     joints.sort_by_key(|(k, _)| *k);
+    let mut headings: Vec<(usize, ImuHeading)> = headings.into_iter().collect();
+    headings.sort_by_key(|(k, _)| *k);
     Ok(Correction {
+        headings: headings.into_iter().map(|(_, h)| h).collect(),
         variant,
         settings: *settings,
         corrected,
@@ -207,8 +235,60 @@ fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &s
 enum Applied {
     /// A fresh per-sample correction `C(t)`, to apply as `G_R_dist * C(t)`.
     Series(Vec<Quat>),
-    /// The corrected orientations of an earlier run, kept as they were.
+    /// Corrected orientations to take as they are (a heading fit, or an
+    /// earlier run's kept result).
     Kept(Vec<Quat>),
+}
+
+/// Fits the heading model of one joint's distal IMU: the window solutions (each
+/// holding the constant C and its window's cost), the IMU's heading record and
+/// its corrected orientations `R_up(-h(t)) G_R_dist C`.
+fn solve_heading(
+    time_s: &[f64],
+    problem: &HeadingProblem,
+    joint: &str,
+    imu: &str,
+) -> (Vec<WindowSolution>, ImuHeading, Vec<Quat>) {
+    let fit = problem.fit(&HeadingOptions::default());
+    let c = canonical(&fit.c);
+    let windows: Vec<WindowSolution> = problem
+        .windows
+        .iter()
+        .enumerate()
+        .map(|(k, w)| WindowSolution {
+            start_s: w.start_s,
+            end_s: w.end_s,
+            centre_s: w.centre_s,
+            samples: w.len(),
+            correction: wxyz(&c),
+            angle_deg: angle_deg(&c),
+            cost: fit.window_costs[k],
+            cost_uncorrected: fit.window_costs_uncorrected[k],
+            evaluations: fit.window_evaluations[k],
+        })
+        .collect();
+    let centres: Vec<f64> = problem.windows.iter().map(|w| w.centre_s).collect();
+    let heading = ImuHeading {
+        imu: imu.to_string(),
+        joint: joint.to_string(),
+        vertical: problem.vertical,
+        correction: wxyz(&c),
+        correction_angle_deg: angle_deg(&c),
+        windows: (0..centres.len())
+            .map(|k| HeadingWindow {
+                centre_s: centres[k],
+                heading_deg: fit.headings_deg[k],
+                rate_deg_s: (k > 0).then(|| {
+                    (fit.headings_deg[k] - fit.headings_deg[k - 1]) / (centres[k] - centres[k - 1])
+                }),
+            })
+            .collect(),
+        rounds: fit.rounds,
+        c_evaluations: fit.c_evaluations,
+    };
+    let series = heading_series(time_s, &centres, &fit.headings_deg);
+    let orientation = apply(problem.child, &c, &series, problem.vertical);
+    (windows, heading, orientation)
 }
 
 /// Solves one joint: the measured joint rotations `Rm_i` (parent' to child), per sample.

@@ -61,7 +61,7 @@ pub fn cost_direct(measured: &[Quat], c: &Quat, limits: &JointLimits, lambda1: f
 
 /// Test of an angle `atan2(s, c)` against a range, without trigonometry.
 #[derive(Debug, Clone, Copy)]
-struct ArcRange {
+pub(super) struct ArcRange {
     lo: f64,
     hi: f64,
     lo_dir: [f64; 2],
@@ -73,7 +73,7 @@ struct ArcRange {
 }
 
 impl ArcRange {
-    fn new([lo, hi]: [f64; 2]) -> Self {
+    pub(super) fn new([lo, hi]: [f64; 2]) -> Self {
         let (sl, cl) = lo.to_radians().sin_cos();
         let (sh, ch) = hi.to_radians().sin_cos();
         ArcRange {
@@ -88,7 +88,7 @@ impl ArcRange {
 
     /// Excursion (degrees) of the angle of the direction `(c, s)` = `atan2(s, c)`.
     #[inline(always)]
-    fn excursion(&self, s: f64, c: f64) -> f64 {
+    pub(super) fn excursion(&self, s: f64, c: f64) -> f64 {
         if self.full {
             return 0.0;
         }
@@ -108,7 +108,7 @@ impl ArcRange {
 
 /// Test of `theta = -asin(r20)` against a range, without trigonometry.
 #[derive(Debug, Clone, Copy)]
-struct PitchRange {
+pub(super) struct PitchRange {
     lo: f64,
     hi: f64,
     /// theta >= lo  <=>  r20 <= r20_max
@@ -118,7 +118,7 @@ struct PitchRange {
 }
 
 impl PitchRange {
-    fn new([lo, hi]: [f64; 2]) -> Self {
+    pub(super) fn new([lo, hi]: [f64; 2]) -> Self {
         let r20_max = if lo <= -90.0 {
             f64::INFINITY
         } else if lo >= 90.0 {
@@ -142,7 +142,7 @@ impl PitchRange {
     }
 
     #[inline(always)]
-    fn excursion(&self, r20: f64) -> f64 {
+    pub(super) fn excursion(&self, r20: f64) -> f64 {
         if r20 <= self.r20_max && r20 >= self.r20_min {
             return 0.0;
         }

@@ -8,6 +8,8 @@
 
 pub mod chain;
 pub mod cost;
+pub mod heading;
+pub mod heading_cost;
 pub mod minimise;
 pub mod window;
 
@@ -15,6 +17,7 @@ pub use chain::{correct_joint, correct_trial, recorrect};
 
 use crate::limits::Settings;
 use crate::trial::Trial;
+use crate::vertical::Vertical;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -40,11 +43,22 @@ pub enum Variant {
     Drift,
     /// Windows + slerp + the centroid term (lambda2 from the table).
     DriftCentroid,
+    /// One constant correction per IMU plus a heading correction about the
+    /// global vertical per window: `G_R' = R_up(-h(t)) G_R C`; no centroid term.
+    DriftHeading,
+    /// As `drift-heading`, with the centroid term.
+    DriftHeadingCentroid,
 }
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 3] = [Variant::Basic, Variant::Drift, Variant::DriftCentroid];
+    pub const ALL: [Variant; 5] = [
+        Variant::Basic,
+        Variant::Drift,
+        Variant::DriftCentroid,
+        Variant::DriftHeading,
+        Variant::DriftHeadingCentroid,
+    ];
 
     /// The name used on the command line, in files and on screen.
     pub fn name(self) -> &'static str {
@@ -52,6 +66,8 @@ impl Variant {
             Variant::Basic => "basic",
             Variant::Drift => "drift",
             Variant::DriftCentroid => "drift-centroid",
+            Variant::DriftHeading => "drift-heading",
+            Variant::DriftHeadingCentroid => "drift-heading-centroid",
         }
     }
 
@@ -67,7 +83,12 @@ impl Variant {
 
     /// Uses the table's centroid term.
     pub fn centroid(self) -> bool {
-        matches!(self, Variant::DriftCentroid)
+        matches!(self, Variant::DriftCentroid | Variant::DriftHeadingCentroid)
+    }
+
+    /// Models drift as a heading rotation about the global vertical.
+    pub fn heading(self) -> bool {
+        matches!(self, Variant::DriftHeading | Variant::DriftHeadingCentroid)
     }
 }
 
@@ -113,6 +134,68 @@ pub struct JointResult {
     pub windows: Vec<WindowSolution>,
 }
 
+/// The heading correction of one window of a heading-drift variant.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HeadingWindow {
+    /// Window centre, seconds from the first sample.
+    pub centre_s: f64,
+    /// Estimated heading drift `h_k`, degrees about the global up axis (the
+    /// rotation the sensor's orientation had turned by, and that was removed).
+    pub heading_deg: f64,
+    /// Drift rate since the previous window centre, degrees per second (none
+    /// for the first window).
+    pub rate_deg_s: Option<f64>,
+}
+
+/// The estimated heading drift of one IMU (heading-drift variants):
+/// `G_R' = R_up(-h(t)) G_R C`, h linear between window centres.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImuHeading {
+    pub imu: String,
+    /// The joint whose correction fitted it (the IMU is its distal one).
+    pub joint: String,
+    /// The global frame's up axis the headings turn about.
+    pub vertical: Vertical,
+    /// The constant correction C (sensor frame), `[w, x, y, z]`, w >= 0.
+    pub correction: [f64; 4],
+    /// Rotation angle of C, degrees.
+    pub correction_angle_deg: f64,
+    pub windows: Vec<HeadingWindow>,
+    /// Alternation rounds and C-step cost evaluations spent.
+    pub rounds: usize,
+    pub c_evaluations: usize,
+}
+
+impl ImuHeading {
+    /// Least-squares slope of the window headings over their centres, degrees
+    /// per second (0 with fewer than two windows).
+    pub fn mean_rate_deg_s(&self) -> f64 {
+        let n = self.windows.len() as f64;
+        if self.windows.len() < 2 {
+            return 0.0;
+        }
+        let mt = self.windows.iter().map(|w| w.centre_s).sum::<f64>() / n;
+        let mh = self.windows.iter().map(|w| w.heading_deg).sum::<f64>() / n;
+        let (num, den) = self.windows.iter().fold((0.0, 0.0), |(a, b), w| {
+            let dt = w.centre_s - mt;
+            (a + dt * (w.heading_deg - mh), b + dt * dt)
+        });
+        if den > 0.0 {
+            num / den
+        } else {
+            0.0
+        }
+    }
+
+    /// The largest absolute window heading, degrees.
+    pub fn max_abs_heading_deg(&self) -> f64 {
+        self.windows
+            .iter()
+            .map(|w| w.heading_deg.abs())
+            .fold(0.0, f64::max)
+    }
+}
+
 /// A joint the engine did not correct, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SkippedJoint {
@@ -131,12 +214,20 @@ pub struct Correction {
     pub joints: Vec<JointResult>,
     /// Joints of the model that were not corrected.
     pub skipped: Vec<SkippedJoint>,
+    /// Estimated heading drift per corrected IMU, in model order (heading-drift
+    /// variants only; empty otherwise).
+    pub headings: Vec<ImuHeading>,
 }
 
 impl Correction {
     /// The result for a joint.
     pub fn joint(&self, name: &str) -> Option<&JointResult> {
         self.joints.iter().find(|j| j.joint == name)
+    }
+
+    /// The estimated heading drift of an IMU (heading-drift variants).
+    pub fn heading(&self, imu: &str) -> Option<&ImuHeading> {
+        self.headings.iter().find(|h| h.imu == imu)
     }
 }
 

@@ -27,6 +27,10 @@ pub struct EngineArgs {
     /// Hop between drift windows, seconds [default: 30].
     #[arg(long)]
     pub hop: Option<f64>,
+    /// The global frame's up axis: `z-up`, or `z-down` for north-east-down
+    /// recordings [default: from ./joint_limits/settings.toml, else z-up].
+    #[arg(long)]
+    pub vertical: Option<acm_workbench::vertical::Vertical>,
     /// Worker threads [default: all cores]; results do not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -80,6 +84,7 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
         lambda1: args.lambda1.unwrap_or(defaults.lambda1),
         window_s: args.window.unwrap_or(defaults.window_s),
         hop_s: args.hop.unwrap_or(defaults.hop_s),
+        vertical: args.vertical.unwrap_or(defaults.vertical),
     };
     settings.validate("command line")?;
     Ok(Context {

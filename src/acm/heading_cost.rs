@@ -1,0 +1,204 @@
+//! The ACM cost of one joint over one window as a function of the distal IMU's
+//! heading correction `h` (degrees), its sensor-frame correction C held fixed.
+//!
+//! With the heading model the corrected distal orientation is
+//! `G_R_dist' = R_up(-h) * G_R_dist * C`, so the joint rotation is
+//! `Rt(h) = P'^T * R_up(-h) * B` with `P' = G_R_prox'` (the corrected parent) and
+//! `B = G_R_dist * C`. By Rodrigues, `R_up(-h) = I - sin(h) K + (1 - cos(h)) K^2`
+//! with `K = [up]x`, so `Rt(h) = M0 + sin(h) M1 + (1 - cos(h)) M2` with three
+//! matrices per sample prepared once; only the five entries the Z-Y-X angles need
+//! are kept. The quaternion of `Rt(h)` is `cos(h/2) a + sin(h/2) b` likewise, so
+//! the centroid term costs two dot products per sample prepared once.
+//!
+//! The value is the window cost of METHOD.md section 3 with the heading term:
+//! `e(C, h) = (1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i)
+//!            + lambda1 * angle(C) + lambda1 * |h|` (degrees).
+
+use super::cost::{ArcRange, PitchRange};
+use crate::limits::JointLimits;
+use crate::rotation::{angle_deg, quat_from_euler_zyx_deg, Quat};
+use nalgebra::{Matrix3, Quaternion};
+
+/// The entries `r00, r10, r20, r21, r22` of a rotation matrix.
+type Entries = [f64; 5];
+
+fn entries(m: &Matrix3<f64>) -> Entries {
+    [m[(0, 0)], m[(1, 0)], m[(2, 0)], m[(2, 1)], m[(2, 2)]]
+}
+
+/// One sample prepared for evaluation at any heading.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    m0: Entries,
+    m1: Entries,
+    m2: Entries,
+    /// `a . qc` and `b . qc` (0 without centroid term).
+    centroid_dots: [f64; 2],
+}
+
+/// The cost of one joint over one window as a function of the heading correction.
+#[derive(Debug, Clone)]
+pub struct HeadingCost {
+    samples: Vec<Sample>,
+    x: ArcRange,
+    y: PitchRange,
+    z: ArcRange,
+    centroid: bool,
+    lambda2: f64,
+    lambda1: f64,
+    /// `lambda1 * angle(C)`.
+    c_penalty: f64,
+}
+
+impl HeadingCost {
+    /// Prepares the cost for corrected parent orientations `parent` (`G_R_prox'`),
+    /// raw distal orientations `child` (`G_R_dist`), the fixed correction `c`
+    /// (distal sensor frame) and the global up vector `up`; every `stride`-th
+    /// sample is taken (1 = all).
+    pub fn new(
+        parent: &[Quat],
+        child: &[Quat],
+        c: &Quat,
+        up: [f64; 3],
+        limits: &JointLimits,
+        lambda1: f64,
+        stride: usize,
+    ) -> Self {
+        let k = Matrix3::new(
+            0.0, -up[2], up[1], //
+            up[2], 0.0, -up[0], //
+            -up[1], up[0], 0.0,
+        );
+        let k2 = k * k;
+        let centroid = match limits.centroid_deg {
+            Some(c) if limits.lambda2 > 0.0 => Some(quat_from_euler_zyx_deg(c)),
+            _ => None,
+        };
+        let minus_up = Quaternion::new(0.0, -up[0], -up[1], -up[2]);
+        let samples = parent
+            .iter()
+            .zip(child)
+            .step_by(stride.max(1))
+            .map(|(p, d)| {
+                let b = d * c;
+                let pt = p.inverse();
+                let pm = pt.to_rotation_matrix().into_inner();
+                let bm = b.to_rotation_matrix().into_inner();
+                let centroid_dots = match centroid {
+                    Some(qc) => {
+                        let qa = pt.into_inner() * b.into_inner();
+                        let qb = pt.into_inner() * minus_up * b.into_inner();
+                        [qa.coords.dot(&qc.coords), qb.coords.dot(&qc.coords)]
+                    }
+                    None => [0.0, 0.0],
+                };
+                Sample {
+                    m0: entries(&(pm * bm)),
+                    m1: entries(&(-(pm * k * bm))),
+                    m2: entries(&(pm * k2 * bm)),
+                    centroid_dots,
+                }
+            })
+            .collect();
+        HeadingCost {
+            samples,
+            x: ArcRange::new(limits.range_deg[0]),
+            y: PitchRange::new(limits.range_deg[1]),
+            z: ArcRange::new(limits.range_deg[2]),
+            centroid: centroid.is_some(),
+            lambda2: limits.lambda2,
+            lambda1,
+            c_penalty: lambda1 * angle_deg(c),
+        }
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// True when the window holds no sample.
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// `e(C, h)` for the heading correction `h_deg` (degrees about the up axis).
+    pub fn eval(&self, h_deg: f64) -> f64 {
+        let penalty = self.c_penalty + self.lambda1 * h_deg.abs();
+        if self.samples.is_empty() {
+            return penalty;
+        }
+        let (s, c) = h_deg.to_radians().sin_cos();
+        let v = 1.0 - c;
+        let (sh, ch) = (0.5 * h_deg.to_radians()).sin_cos();
+        let mut sum = 0.0;
+        for p in &self.samples {
+            let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
+            let (r00, r10, r20, r21, r22) = (r(0), r(1), r(2), r(3), r(4));
+            sum += self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00);
+            if self.centroid {
+                let d = ch * p.centroid_dots[0] + sh * p.centroid_dots[1];
+                sum += self.lambda2 * (2.0 - 2.0 * d.abs()).max(0.0).sqrt();
+            }
+        }
+        sum / self.samples.len() as f64 + penalty
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::acm::cost::cost_direct;
+    use crate::rotation::quat_axis_angle_deg;
+    use crate::vertical::Vertical;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_quat(rng: &mut ChaCha8Rng, max_deg: f64) -> Quat {
+        let axis = [
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        ];
+        quat_axis_angle_deg(axis, rng.random_range(0.0..max_deg))
+    }
+
+    fn check(limits: JointLimits, vertical: Vertical) {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let parent: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
+        let child: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
+        for _ in 0..10 {
+            let c = random_quat(&mut rng, 40.0);
+            let cost = HeadingCost::new(&parent, &child, &c, vertical.up(), &limits, 0.05, 1);
+            for h in [-170.0, -33.0, 0.0, 4.5, 90.0] {
+                let r = vertical.heading_rotation(-h);
+                let measured: Vec<Quat> = parent
+                    .iter()
+                    .zip(&child)
+                    .map(|(p, d)| p.inverse() * r * d)
+                    .collect();
+                let direct = cost_direct(&measured, &c, &limits, 0.05) + 0.05 * f64::abs(h);
+                let fast = cost.eval(h);
+                assert!((fast - direct).abs() < 1e-9, "h {h}: {fast} vs {direct}");
+            }
+        }
+    }
+
+    #[test]
+    fn heading_cost_equals_the_direct_formula() {
+        let knee = JointLimits {
+            range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
+            centroid_deg: None,
+            lambda2: 0.0,
+        };
+        let shoulder = JointLimits {
+            range_deg: [[-10.0, 100.0], [-40.0, 60.0], [-70.0, 70.0]],
+            centroid_deg: Some([47.0, -1.0, -31.0]),
+            lambda2: 30.0,
+        };
+        check(knee.clone(), Vertical::ZUp);
+        check(shoulder.clone(), Vertical::ZUp);
+        check(shoulder, Vertical::ZDown);
+        check(knee, Vertical::ZDown);
+    }
+}
