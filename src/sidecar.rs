@@ -2,7 +2,7 @@
 //! which settings and table, the per-window corrections and the figures, enough
 //! to reproduce the output exactly.
 
-use crate::acm::{Correction, JointResult, SkippedJoint, Variant};
+use crate::acm::{Correction, ImuHeading, JointResult, SkippedJoint, Variant};
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
@@ -55,6 +55,9 @@ pub struct Sidecar {
     pub limits: TableRecord,
     pub joints: Vec<JointResult>,
     pub skipped: Vec<SkippedJoint>,
+    /// Estimated heading drift per IMU over time (heading-drift variants only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub headings: Vec<ImuHeading>,
     pub figures: FiguresRecord,
     pub warnings: Vec<String>,
 }
@@ -103,6 +106,7 @@ impl Sidecar {
             },
             joints: correction.joints.clone(),
             skipped: correction.skipped.clone(),
+            headings: correction.headings.clone(),
             figures,
             warnings: Vec::new(),
         }
