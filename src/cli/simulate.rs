@@ -1,7 +1,8 @@
 //! `acmw simulate`: write a simulated trial and its truth beside it.
 
 use acm_workbench::simulate::{
-    self, HeadingDrift, ImuMisalignment, KneeAxis, KneeImu, Misalignment, SimConfig,
+    self, HeadingDrift, ImuMisalignment, KneeAxis, KneeImu, Misalignment, SensorSlip,
+    SimConfig,
     RANDOM_MISALIGNMENT_DEG,
 };
 use acm_workbench::truth::{self, Truth};
@@ -88,6 +89,10 @@ pub struct CommonArgs {
     /// Heading drift IMU:START_S:RATE_DEG_S about the global vertical (repeatable).
     #[arg(long, value_parser = parse_drift, allow_hyphen_values = true)]
     pub drift: Vec<HeadingDrift>,
+    /// Sensor slippage IMU:START_S:RATE_DEG_S:AX:AY:AZ, a rotation about a
+    /// sensor-frame axis growing from START_S (repeatable).
+    #[arg(long, value_parser = parse_slip, allow_hyphen_values = true)]
+    pub slip: Vec<SensorSlip>,
     /// Output trial file (`.csv` or `.csv.gz`); the truth goes beside it.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -115,6 +120,26 @@ fn parse_drift(s: &str) -> Result<HeadingDrift, String> {
         imu: imu.trim().to_string(),
         start_s: num(start, "start")?,
         rate_deg_s: num(rate, "rate")?,
+    })
+}
+
+fn parse_slip(s: &str) -> Result<SensorSlip, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let [imu, start, rate, ax, ay, az] = parts[..] else {
+        return Err(format!(
+            "expected IMU:START_S:RATE_DEG_S:AX:AY:AZ, found '{s}'"
+        ));
+    };
+    let num = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{v}' is not a number"))
+    };
+    Ok(SensorSlip {
+        imu: imu.trim().to_string(),
+        start_s: num(start)?,
+        rate_deg_s: num(rate)?,
+        axis: [num(ax)?, num(ay)?, num(az)?],
     })
 }
 
@@ -150,6 +175,9 @@ impl CommonArgs {
         }
         if !self.drift.is_empty() {
             cfg.drifts = self.drift.clone();
+        }
+        if !self.slip.is_empty() {
+            cfg.slips = self.slip.clone();
         }
     }
 }
@@ -239,6 +267,12 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
         println!(
             "  heading drift: {} from {} s at {} deg/s",
             d.imu, d.start_s, d.rate_deg_s
+        );
+    }
+    for d in &cfg.slips {
+        println!(
+            "  sensor slippage: {} from {} s at {} deg/s about sensor axis {:?}",
+            d.imu, d.start_s, d.rate_deg_s, d.axis
         );
     }
     println!("wrote {} (segment orientations)", truth_csv.display());

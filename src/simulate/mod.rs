@@ -11,6 +11,11 @@
 //!   `G_R_imu_measured(t) = Rz(h(t)) * G_R_segment(t) * M * N(t)`,
 //!   where `N(t)` is per-sample noise, a small random rotation in the sensor frame
 //!   whose rotation angle has the RMS [`SimConfig::noise_deg`].
+//! - Sensor slippage (the strap turning slowly on the limb) is a rotation
+//!   `S(t)` about a fixed sensor-frame axis by `s(t)` degrees, 0 before its
+//!   start, then growing at a constant rate: `... * M * S(t) * N(t)`. It is the
+//!   error the source's windowed sensor-frame correction models; heading drift
+//!   is the one the `drift-heading` variants model.
 //! - The base IMU is assumed correct: never misaligned nor drifting (it gets
 //!   noise like every sensor).
 //! - Joint angles are Z-Y-X Euler angles of `G_R_prox^T * G_R_dist`, degrees;
@@ -68,6 +73,9 @@ pub struct SimConfig {
     /// Heading drifts, at most one per IMU, never on the base.
     #[serde(default)]
     pub drifts: Vec<HeadingDrift>,
+    /// Sensor slippages, at most one per IMU, never on the base.
+    #[serde(default)]
+    pub slips: Vec<SensorSlip>,
 }
 
 /// The simulated movement.
@@ -153,6 +161,32 @@ impl HeadingDrift {
     }
 }
 
+/// Slippage of one IMU on its segment: a rotation about the sensor-frame axis
+/// `axis` by `s(t) = 0` before `start_s`, then `rate_deg_s * (t - start_s)`
+/// degrees, applied after the misalignment (`G_R_imu = G_R_seg * M * S(t)`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SensorSlip {
+    pub imu: String,
+    /// When the slippage starts, seconds from the first sample.
+    pub start_s: f64,
+    /// Slippage rate, degrees per second.
+    pub rate_deg_s: f64,
+    /// Rotation axis in the sensor frame (any length but zero).
+    pub axis: [f64; 3],
+}
+
+impl SensorSlip {
+    /// `S(t)`.
+    pub fn rotation_at(&self, t_s: f64) -> Quat {
+        let angle = if t_s <= self.start_s {
+            0.0
+        } else {
+            self.rate_deg_s * (t_s - self.start_s)
+        };
+        rotation::quat_axis_angle_deg(self.axis, angle)
+    }
+}
+
 /// A simulated trial: what the sensors report, and the truth behind it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Simulated {
@@ -182,6 +216,7 @@ impl SimConfig {
             noise_deg: 0.0,
             misalignment: Misalignment::None,
             drifts: vec![],
+            slips: vec![],
         }
     }
 
@@ -199,6 +234,7 @@ impl SimConfig {
                 max_deg: RANDOM_MISALIGNMENT_DEG[1],
             },
             drifts: vec![],
+            slips: vec![],
         }
     }
 
@@ -293,6 +329,21 @@ impl SimConfig {
                 return err(format!("drift of '{}' is not finite", d.imu));
             }
         }
+        for (k, d) in self.slips.iter().enumerate() {
+            check_imu(&d.imu, "slippage")?;
+            if self.slips[..k].iter().any(|o| o.imu == d.imu) {
+                return err(format!("slippage: IMU '{}' is listed twice", d.imu));
+            }
+            let finite = d.start_s.is_finite()
+                && d.rate_deg_s.is_finite()
+                && d.axis.iter().all(|a| a.is_finite());
+            if !finite || d.axis.iter().all(|&a| a == 0.0) {
+                return err(format!(
+                    "slippage of '{}' needs finite numbers and a non-zero axis",
+                    d.imu
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -365,11 +416,15 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
     for (name, seg) in &segments {
         let m = misalignments[name];
         let drift = config.drifts.iter().find(|d| &d.imu == name);
+        let slip = config.slips.iter().find(|d| &d.imu == name);
         let orientation = seg
             .iter()
             .zip(&time_s)
             .map(|(s, &t)| {
                 let mut q = s * m;
+                if let Some(d) = slip {
+                    q *= d.rotation_at(t);
+                }
                 if let Some(d) = drift {
                     q = d.rotation_at(t) * q;
                 }

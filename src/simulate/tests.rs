@@ -107,6 +107,12 @@ fn simulate_full_body_measured_is_drift_segment_misalignment() {
             start_s: 5.0,
             rate_deg_s: 0.5,
         }],
+        slips: vec![SensorSlip {
+            imu: "l_calf".into(),
+            start_s: 2.0,
+            rate_deg_s: 0.3,
+            axis: [1.0, 2.0, 0.0],
+        }],
         ..short_full_body(3, 20.0)
     };
     let sim = simulate(&cfg).unwrap();
@@ -118,7 +124,12 @@ fn simulate_full_body_measured_is_drift_segment_misalignment() {
         let drift = cfg.drifts.iter().find(|d| d.imu == seg.name);
         for ((s, q), &t) in seg.orientation.iter().zip(meas).zip(&sim.trial.time_s) {
             let h = drift.map_or(0.0, |d| d.heading_deg(t));
-            let want = rotation::quat_axis_angle_deg([0.0, 0.0, 1.0], h) * s * m;
+            let slip = match cfg.slips.iter().find(|d| d.imu == seg.name) {
+                Some(_) if t <= 2.0 => Quat::identity(),
+                Some(_) => rotation::quat_axis_angle_deg([1.0, 2.0, 0.0], 0.3 * (t - 2.0)),
+                None => Quat::identity(),
+            };
+            let want = rotation::quat_axis_angle_deg([0.0, 0.0, 1.0], h) * s * m * slip;
             assert!(angle_between_deg(q, &want) < 1e-9, "{} at {t}", seg.name);
         }
     }
@@ -300,6 +311,18 @@ fn simulate_presets_and_validation() {
             ..short_full_body(1, 1.0)
         },
         "twice",
+    );
+    bad(
+        SimConfig {
+            slips: vec![SensorSlip {
+                imu: "l_foot".into(),
+                start_s: 0.0,
+                rate_deg_s: 0.1,
+                axis: [0.0; 3],
+            }],
+            ..short_full_body(1, 1.0)
+        },
+        "non-zero axis",
     );
     bad(
         SimConfig {
