@@ -1,5 +1,6 @@
 //! Engine benchmarks (issue 3): loading, whole-trial correction of 5- and
-//! 30-minute 13-IMU trials at 50 Hz, one joint re-corrected, and peak memory.
+//! 30-minute 13-IMU trials at 50 Hz, one joint re-corrected, the heading-drift
+//! variants against the source's (`-- heading`), and peak memory.
 //!
 //! Run with `cargo bench --bench engine`. The memory figure is printed once
 //! before the timings: peak heap growth during a `drift-centroid` correction,
@@ -10,7 +11,7 @@ use acm_workbench::acm::{correct_joint, correct_trial, RunControl, Variant};
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::Quat;
-use acm_workbench::simulate::{simulate, SimConfig};
+use acm_workbench::simulate::{preset, simulate, SimConfig};
 use acm_workbench::trial::{read_trial, write_trial, Trial, TrialFormat};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -114,6 +115,23 @@ fn benches(c: &mut Criterion) {
     g.bench_function("one joint drift-centroid 5 min", |b| {
         b.iter(|| correct_joint(&five.time_s, &measured, &windows, &lim, 0.05))
     });
+    g.finish();
+
+    // The heading model against the source's on the same 5-minute trials, one
+    // without drift and the drifting preset (issue 9: within 2x).
+    let drifting = simulate(&preset("full_body_drift").unwrap()).unwrap().trial;
+    let mut g = c.benchmark_group("heading");
+    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    for (name, t) in [("5 min", &five), ("5 min drifting", &drifting)] {
+        for v in [
+            Variant::Drift,
+            Variant::DriftHeading,
+            Variant::DriftCentroid,
+            Variant::DriftHeadingCentroid,
+        ] {
+            g.bench_function(format!("{v} {name}"), |b| b.iter(|| run(t, v)));
+        }
+    }
     g.finish();
 }
 

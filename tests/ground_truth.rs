@@ -134,7 +134,10 @@ fn full_body_rows() -> Vec<JointRow> {
         .map(|d| d.imu.clone())
         .collect();
     assert!(sim.truth.meta.drifts.iter().all(|d| d.rate_deg_s <= 0.1));
-    let runs: Vec<Correction> = Variant::ALL[..3].iter().map(|&v| run(&sim.trial, v)).collect();
+    let runs: Vec<Correction> = Variant::ALL[..3]
+        .iter()
+        .map(|&v| run(&sim.trial, v))
+        .collect();
     model
         .joints
         .iter()

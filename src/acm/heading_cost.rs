@@ -196,8 +196,8 @@ mod tests {
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
         };
-        check(knee.clone(), Vertical::ZUp);
-        check(shoulder.clone(), Vertical::ZUp);
+        check(knee, Vertical::ZUp);
+        check(shoulder, Vertical::ZUp);
         check(shoulder, Vertical::ZDown);
         check(knee, Vertical::ZDown);
     }

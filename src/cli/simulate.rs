@@ -1,8 +1,7 @@
 //! `acmw simulate`: write a simulated trial and its truth beside it.
 
 use acm_workbench::simulate::{
-    self, HeadingDrift, ImuMisalignment, KneeAxis, KneeImu, Misalignment, SensorSlip,
-    SimConfig,
+    self, HeadingDrift, ImuMisalignment, KneeAxis, KneeImu, Misalignment, SensorSlip, SimConfig,
     RANDOM_MISALIGNMENT_DEG,
 };
 use acm_workbench::truth::{self, Truth};
