@@ -71,6 +71,17 @@ impl Variant {
         }
     }
 
+    /// A name of at most 6 characters for narrow columns.
+    pub fn short_name(self) -> &'static str {
+        match self {
+            Variant::Basic => "basic",
+            Variant::Drift => "drift",
+            Variant::DriftCentroid => "d+c",
+            Variant::DriftHeading => "d+h",
+            Variant::DriftHeadingCentroid => "d+h+c",
+        }
+    }
+
     /// Parses a variant name.
     pub fn from_name(name: &str) -> Option<Variant> {
         Variant::ALL.into_iter().find(|v| v.name() == name)

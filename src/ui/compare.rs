@@ -25,6 +25,19 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let truth = e.loaded().is_some_and(|l| l.truth.is_some());
     let cw = if truth { 14 } else { 8 };
     let nw = 12usize;
+    // The variant columns that fit, always including the selected one.
+    let col_w = cw.max(15);
+    let fits = ((area.width as usize).saturating_sub(2 + nw + cw) / col_w).max(1);
+    let first = app
+        .compare_col
+        .saturating_sub(fits - 1)
+        .min(Variant::ALL.len().saturating_sub(fits));
+    let shown: Vec<(usize, Variant)> = Variant::ALL
+        .into_iter()
+        .enumerate()
+        .skip(first)
+        .take(fits)
+        .collect();
     let mut lines = vec![Line::from(Span::styled(
         if truth {
             "joint mean excursion, deg  /  truth RMS error, deg (mean of X Y Z)"
@@ -37,7 +50,8 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         format!("  {}{:>w$}", fit("joint", nw), "raw", w = cw),
         theme.header,
     )];
-    for (k, v) in Variant::ALL.iter().enumerate() {
+    for (k, v) in &shown {
+        let (k, v) = (*k, v);
         let mut name = v.name().to_string();
         if e.chosen == Some(*v) {
             name = format!("*{name}");
@@ -66,7 +80,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let mut rows: Vec<(String, Vec<String>)> = vec![];
     for (k, j) in before.iter().enumerate() {
         let mut cells = vec![cell(Some(j))];
-        for v in Variant::ALL {
+        for &(_, v) in &shown {
             let fig = e
                 .figures(Some(v))
                 .and_then(|fs| fs.iter().find(|f| f.joint == j.joint));
@@ -77,13 +91,13 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     }
     // Mean over joints.
     let mut mean = vec![num(e.mean_excursion(None), 6)];
-    for v in Variant::ALL {
+    for &(_, v) in &shown {
         mean.push(num(e.mean_excursion(Some(v)), 6));
     }
     for (k, (name, cells)) in rows.iter().enumerate() {
         let mut spans = vec![Span::raw(format!("{name}{:>w$}", cells[0], w = cw))];
         for (c, text) in cells[1..].iter().enumerate() {
-            let style = if c == app.compare_col {
+            let style = if shown[c].0 == app.compare_col {
                 theme.corrected
             } else {
                 Style::default()
@@ -121,7 +135,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             .and_then(|r| r.saved.clone())
             .map(|p| format!(" -> {p}"))
             .unwrap_or_default();
-        status.push(Line::from(format!("  {:<15}{s}{saved}", v.name())));
+        status.push(Line::from(format!("  {:<24}{s}{saved}", v.name())));
     }
     lines.extend(status);
     if e.results.is_empty() && e.running.is_none() {

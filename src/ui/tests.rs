@@ -142,7 +142,7 @@ fn trial_flow_run_compare_save() {
     assert!(app.open_entry().unwrap().results.is_empty());
     keys(&mut app, "r");
     let e = app.open_entry().unwrap();
-    assert_eq!(e.results.len(), 3);
+    assert_eq!(e.results.len(), Variant::ALL.len());
     assert_eq!(e.running, None);
     // Zoom, pan, cursor, variant, joint.
     keys(&mut app, "++");
