@@ -128,8 +128,12 @@ mod tests {
         assert!((e.rho - 1.0 / 3.0).abs() < 1e-9, "{}", e.rho);
         // Readings below the minimum norm are left out; none left is None.
         assert!(estimate_axis(&[[0.0; 3]; 5], MovementKind::Static, 0.0).is_none());
-        let e = estimate_axis(&[[1.0, 0.0, 0.0], [0.0, 0.1, 0.0]], MovementKind::Static, 0.5)
-            .unwrap();
+        let e = estimate_axis(
+            &[[1.0, 0.0, 0.0], [0.0, 0.1, 0.0]],
+            MovementKind::Static,
+            0.5,
+        )
+        .unwrap();
         assert_eq!(e.samples, 1);
     }
 }

@@ -217,7 +217,11 @@ mod tests {
         let truth = quat_axis_angle_deg([1.0, 2.0, -0.5], 140.0);
         let pairs = pairs_for(
             &truth,
-            &[(Vector3::x(), 0.8), (Vector3::y(), 0.6), (Vector3::z(), 0.98)],
+            &[
+                (Vector3::x(), 0.8),
+                (Vector3::y(), 0.6),
+                (Vector3::z(), 0.98),
+            ],
         );
         let f = fit_lm(&pairs, &LmOptions::default());
         assert!(angle_between_deg(&f.q, &truth) < 1e-4, "{:?}", f);

@@ -24,7 +24,9 @@ pub mod recording;
 pub mod simulate;
 
 pub use error::CalibrationError;
-pub use protocol::{Movement, MovementKind, Protocol, SignedAxis};
+pub use protocol::{
+    Movement, MovementKind, Protocol, SignedAxis, DEFAULT_PROTOCOL as DEFAULT_PROTOCOL_NAME,
+};
 pub use recording::{is_calibration_recording, Recording};
 
 use crate::model::Model;
@@ -187,7 +189,11 @@ pub fn calibrate(rec: &Recording, protocol: &Protocol) -> Calibration {
 }
 
 /// The calibration of one IMU, or why it cannot be made.
-fn calibrate_segment(rec: &Recording, protocol: &Protocol, imu: &str) -> Result<SegmentResult, String> {
+fn calibrate_segment(
+    rec: &Recording,
+    protocol: &Protocol,
+    imu: &str,
+) -> Result<SegmentResult, String> {
     let readings = rec
         .imu(imu)
         .ok_or_else(|| "not in the recording".to_string())?;
@@ -286,7 +292,9 @@ pub fn default_output(recording: &Path) -> PathBuf {
 impl Calibration {
     /// The result of an IMU.
     pub fn segment(&self, imu: &str) -> Option<&SegmentResult> {
-        self.segments.iter().find(|s| s.imu.eq_ignore_ascii_case(imu))
+        self.segments
+            .iter()
+            .find(|s| s.imu.eq_ignore_ascii_case(imu))
     }
 
     /// TOML text of the calibration file.
@@ -328,11 +336,13 @@ impl Calibration {
         })
     }
 
-    /// What applying it to a trial does: per IMU the rotation.
-    pub fn applied(&self, file: &str, sha256: &str) -> AppliedCalibration {
+    /// What applying it to a trial does: per IMU the rotation. `text` is the
+    /// file's content, recorded so that a sidecar reproduces it bit for bit.
+    pub fn applied(&self, file: &str, text: &str) -> AppliedCalibration {
         AppliedCalibration {
             file: file.to_string(),
-            sha256: sha256.to_string(),
+            sha256: crate::sidecar::sha256_hex(text.as_bytes()),
+            text: text.to_string(),
             protocol: self.protocol.clone(),
             imus: self
                 .segments
@@ -363,18 +373,35 @@ pub struct AppliedCalibration {
     /// SHA-256 of its bytes.
     pub sha256: String,
     pub protocol: String,
+    /// The rotations, for reading (applying uses `text`).
     pub imus: Vec<AppliedRotation>,
+    /// The calibration file's text (TOML numbers read back exactly; JSON ones
+    /// may not be).
+    pub text: String,
 }
 
 impl AppliedCalibration {
     /// Reads a calibration file and records what applying it means.
     pub fn load(path: &Path) -> Result<AppliedCalibration, CalibrationError> {
         let origin = path.display().to_string();
-        let bytes = std::fs::read(path)
+        let text = std::fs::read_to_string(path)
             .map_err(|e| CalibrationError::file(&origin, format!("cannot read: {e}")))?;
-        let text = String::from_utf8_lossy(&bytes);
         let c = Calibration::from_toml(&text, &origin)?;
-        Ok(c.applied(&origin, &crate::sidecar::sha256_hex(&bytes)))
+        Ok(c.applied(&origin, &text))
+    }
+
+    /// The record read again from its text (as a sidecar holds it), checked
+    /// against its hash; `origin` names the sidecar in errors.
+    pub fn reread(&self, origin: &str) -> Result<AppliedCalibration, CalibrationError> {
+        let c = Calibration::from_toml(&self.text, &format!("{origin} (calibration.text)"))?;
+        let again = c.applied(&self.file, &self.text);
+        if again.sha256 != self.sha256 {
+            return Err(CalibrationError::file(
+                origin,
+                "calibration.text does not match calibration.sha256 (the sidecar was edited?)",
+            ));
+        }
+        Ok(again)
     }
 
     /// Applies the rotations to the trial in place: `G_R_FF = G_R_SF * R^-1` for

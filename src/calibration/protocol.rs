@@ -167,7 +167,10 @@ impl Protocol {
         let mut segments: Vec<String> = Vec::new();
         for s in &raw.segments {
             if segments.iter().any(|x| x.eq_ignore_ascii_case(s.get_ref())) {
-                return Err(at(s.span(), format!("IMU '{}' is listed twice", s.get_ref())));
+                return Err(at(
+                    s.span(),
+                    format!("IMU '{}' is listed twice", s.get_ref()),
+                ));
             }
             segments.push(s.get_ref().clone());
         }
@@ -182,10 +185,16 @@ impl Protocol {
         for m in raw.movements {
             let label = m.label.get_ref().trim().to_string();
             if label.is_empty() {
-                return Err(at(m.label.span(), "a movement label must not be empty".into()));
+                return Err(at(
+                    m.label.span(),
+                    "a movement label must not be empty".into(),
+                ));
             }
             if movements.iter().any(|x| x.label == label) {
-                return Err(at(m.label.span(), format!("movement '{label}' is listed twice")));
+                return Err(at(
+                    m.label.span(),
+                    format!("movement '{label}' is listed twice"),
+                ));
             }
             if m.axes.get_ref().is_empty() {
                 return Err(at(
@@ -280,7 +289,12 @@ mod tests {
             ["supine", "TR", "TFE", "FFEB", "FEB", "FE", "AA", "PS"]
         );
         // Table 1: the thorax has three movements, each arm segment five or six.
-        let count = |seg: &str| p.movements.iter().filter(|m| m.axes.contains_key(seg)).count();
+        let count = |seg: &str| {
+            p.movements
+                .iter()
+                .filter(|m| m.axes.contains_key(seg))
+                .count()
+        };
         assert_eq!(count("upper_back"), 3);
         assert_eq!(count("l_upper_arm"), 5);
         assert_eq!(count("r_forearm"), 6);
@@ -307,7 +321,11 @@ mod tests {
         let e = err(&format!(
             "{HEAD}[[movement]]\nlabel = \"m\"\nkind = \"static\"\naxes = {{ a = \"+q\" }}\n"
         ));
-        assert_eq!((e.file.as_str(), e.line, e.column), ("p.toml", 6, 14), "{e}");
+        assert_eq!(
+            (e.file.as_str(), e.line, e.column),
+            ("p.toml", 6, 14),
+            "{e}"
+        );
         assert!(e.message.contains("expected an axis"), "{e}");
         let e = err(&format!(
             "{HEAD}[[movement]]\nlabel = \"m\"\nkind = \"wiggle\"\naxes = {{ a = \"x\" }}\n"

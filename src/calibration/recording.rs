@@ -106,9 +106,7 @@ impl Recording {
             let mut out = Vec::new();
             flate2::read::MultiGzDecoder::new(&raw[..])
                 .read_to_end(&mut out)
-                .map_err(|e| {
-                    CalibrationError::file(&origin, format!("invalid gzip data: {e}"))
-                })?;
+                .map_err(|e| CalibrationError::file(&origin, format!("invalid gzip data: {e}")))?;
             out
         } else {
             raw
@@ -178,20 +176,31 @@ impl Recording {
                 return Err(err(
                     line,
                     r.len().min(width) + 1,
-                    format!("expected {width} fields as in the header, found {}", r.len()),
+                    format!(
+                        "expected {width} fields as in the header, found {}",
+                        r.len()
+                    ),
                 ));
             }
             let num = |col: usize| -> Result<f64, CalibrationError> {
                 let f = std::str::from_utf8(&r[col]).map_err(|_| {
-                    err(line, col + 1, "expected UTF-8 text, found invalid bytes".into())
+                    err(
+                        line,
+                        col + 1,
+                        "expected UTF-8 text, found invalid bytes".into(),
+                    )
                 })?;
-                let v: f64 = f.parse().map_err(|_| {
-                    err(line, col + 1, format!("expected a number, found '{f}'"))
-                })?;
+                let v: f64 = f
+                    .parse()
+                    .map_err(|_| err(line, col + 1, format!("expected a number, found '{f}'")))?;
                 if v.is_finite() {
                     Ok(v)
                 } else {
-                    Err(err(line, col + 1, format!("expected a finite number, found '{f}'")))
+                    Err(err(
+                        line,
+                        col + 1,
+                        format!("expected a finite number, found '{f}'"),
+                    ))
                 }
             };
             let t = num(0)?;
@@ -226,7 +235,11 @@ impl Recording {
             }
         }
         if rec.time_s.is_empty() {
-            return Err(err(hline + 1, 1, "expected data rows after the header".into()));
+            return Err(err(
+                hline + 1,
+                1,
+                "expected data rows after the header".into(),
+            ));
         }
         Ok(rec)
     }
@@ -261,11 +274,17 @@ fn parse_header(h: &csv::ByteRecord, line: u64, origin: &str) -> Result<Layout, 
     let err = |col: usize, m: String| CalibrationError::at(origin, line, col, m);
     let field = |i: usize| String::from_utf8_lossy(&h[i]).to_string();
     if h.is_empty() || !field(0).eq_ignore_ascii_case("time") {
-        return Err(err(1, format!("expected 'time' as the first column, found '{}'", field(0))));
+        return Err(err(
+            1,
+            format!("expected 'time' as the first column, found '{}'", field(0)),
+        ));
     }
     if h.len() < 2 || !field(1).eq_ignore_ascii_case("label") {
         let f = if h.len() > 1 { field(1) } else { String::new() };
-        return Err(err(2, format!("expected 'label' as the second column, found '{f}'")));
+        return Err(err(
+            2,
+            format!("expected 'label' as the second column, found '{f}'"),
+        ));
     }
     let mut names: Vec<String> = vec![];
     let mut slots: Vec<[Option<usize>; 6]> = vec![];
@@ -296,7 +315,10 @@ fn parse_header(h: &csv::ByteRecord, line: u64, origin: &str) -> Result<Layout, 
         slots[k][ch] = Some(i);
     }
     if names.is_empty() {
-        return Err(err(3, "expected IMU columns <imu>_ax,...,<imu>_gz after 'label'".into()));
+        return Err(err(
+            3,
+            "expected IMU columns <imu>_ax,...,<imu>_gz after 'label'".into(),
+        ));
     }
     let mut out = vec![];
     for (k, s) in slots.iter().enumerate() {
@@ -305,7 +327,10 @@ fn parse_header(h: &csv::ByteRecord, line: u64, origin: &str) -> Result<Layout, 
             cols[c] = slot.ok_or_else(|| {
                 err(
                     0,
-                    format!("IMU '{}' lacks column '{}_{}'", names[k], names[k], CHANNELS[c]),
+                    format!(
+                        "IMU '{}' lacks column '{}_{}'",
+                        names[k], names[k], CHANNELS[c]
+                    ),
                 )
             })?;
         }
@@ -343,7 +368,10 @@ mod tests {
     #[test]
     fn errors_name_line_and_column() {
         let e = parse(&format!("{HEAD}0,s,0,0,x,0,0,0\n")).unwrap_err();
-        assert_eq!((e.file.as_str(), e.line, e.column), ("dir/r.calib.csv", 2, 5));
+        assert_eq!(
+            (e.file.as_str(), e.line, e.column),
+            ("dir/r.calib.csv", 2, 5)
+        );
         assert!(e.message.contains("expected a number, found 'x'"), "{e}");
         let e = parse(&format!("{HEAD}0,s,0,0,0,0,0,0\n0,s,0,0,0,0,0,0\n")).unwrap_err();
         assert_eq!((e.line, e.column), (3, 1));

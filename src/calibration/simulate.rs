@@ -186,7 +186,10 @@ impl Smooth {
     }
 
     fn at(&self, t: f64) -> f64 {
-        self.waves.iter().map(|(a, om, ph)| a * (om * t + ph).sin()).sum()
+        self.waves
+            .iter()
+            .map(|(a, om, ph)| a * (om * t + ph).sin())
+            .sum()
     }
 }
 
@@ -249,7 +252,10 @@ pub fn simulate(
         .iter()
         .map(|imu| {
             let drawn = random_rotation(&mut rng);
-            let q = config.rotations.get(imu).map_or(drawn, |q| quat_from_wxyz(*q));
+            let q = config
+                .rotations
+                .get(imu)
+                .map_or(drawn, |q| quat_from_wxyz(*q));
             filled.rotations.insert(imu.clone(), wxyz(&q));
             (imu.clone(), q)
         })
@@ -273,9 +279,9 @@ pub fn simulate(
     };
     let rest_rows = config.rate_hz.round() as usize;
     let push = |rec: &mut Recording,
-                    rng: &mut ChaCha8Rng,
-                    label: Option<u32>,
-                    ff: &[(Vector3<f64>, Vector3<f64>)]| {
+                rng: &mut ChaCha8Rng,
+                label: Option<u32>,
+                ff: &[(Vector3<f64>, Vector3<f64>)]| {
         rec.time_s.push(rec.time_s.len() as f64 * dt);
         rec.label_of.push(label);
         for (k, (_, q)) in truth.iter().enumerate() {
@@ -284,8 +290,10 @@ pub fn simulate(
             let a = inv * acc;
             let g = inv * gyro;
             let imu = &mut rec.imus[k];
-            imu.acc.push([0, 1, 2].map(|i| a[i] + acc_noise.sample(rng)));
-            imu.gyro.push([0, 1, 2].map(|i| g[i] + gyro_noise.sample(rng)));
+            imu.acc
+                .push([0, 1, 2].map(|i| a[i] + acc_noise.sample(rng)));
+            imu.gyro
+                .push([0, 1, 2].map(|i| g[i] + gyro_noise.sample(rng)));
         }
     };
     let still = (Vector3::x() * GRAVITY, Vector3::zeros());
@@ -296,10 +304,14 @@ pub fn simulate(
         }
         rec.labels.push(m.label.clone());
         let label = Some((rec.labels.len() - 1) as u32);
-        let slop = config.overrides.get(&m.label).copied().unwrap_or(match m.kind {
-            MovementKind::Static => config.still,
-            MovementKind::Functional => config.moving,
-        });
+        let slop = config
+            .overrides
+            .get(&m.label)
+            .copied()
+            .unwrap_or(match m.kind {
+                MovementKind::Static => config.still,
+                MovementKind::Functional => config.moving,
+            });
         let axes: Vec<Option<MovingAxis>> = truth
             .iter()
             .map(|(imu, _)| {
@@ -336,4 +348,47 @@ pub fn simulate(
         truth,
         config: filled,
     })
+}
+
+/// The truth file of a simulated recording: `<stem>.truth.json` beside it
+/// (`x.calib.csv.gz` -> `x.calib.truth.json`), holding the configuration with
+/// every true rotation.
+pub fn truth_path(recording: &std::path::Path) -> std::path::PathBuf {
+    let name = recording.file_name().unwrap_or_default().to_string_lossy();
+    let lower = name.to_ascii_lowercase();
+    let mut stem_len = name.len();
+    for ext in [".gz", ".csv"] {
+        if lower[..stem_len].ends_with(ext) {
+            stem_len -= ext.len();
+        }
+    }
+    recording.with_file_name(format!("{}.truth.json", &name[..stem_len]))
+}
+
+/// The true rotations SF -> FF per IMU from the truth file beside a recording,
+/// when there is one.
+pub fn load_truth_beside(
+    recording: &std::path::Path,
+) -> Option<Result<BTreeMap<String, Quat>, super::CalibrationError>> {
+    let path = truth_path(recording);
+    if !path.exists() {
+        return None;
+    }
+    let origin = path.display().to_string();
+    Some((|| {
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| super::CalibrationError::file(&origin, format!("cannot read: {e}")))?;
+        let c: CalibSimConfig = serde_json::from_str(&text).map_err(|e| {
+            super::CalibrationError::at(
+                &origin,
+                e.line() as u64,
+                e.column(),
+                format!("not a calibration simulation truth: {e}"),
+            )
+        })?;
+        Ok(c.rotations
+            .iter()
+            .map(|(k, q)| (k.clone(), quat_from_wxyz(*q)))
+            .collect())
+    })())
 }

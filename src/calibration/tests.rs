@@ -101,10 +101,18 @@ fn rho_near_one_for_postures_lower_for_sloppy_movements() {
         for a in &s.axes {
             match a.kind {
                 // Table 1: 0.97-0.99 for the supine posture.
-                MovementKind::Static => assert!(a.rho > 0.97, "{} {}: {}", s.imu, a.movement, a.rho),
+                MovementKind::Static => {
+                    assert!(a.rho > 0.97, "{} {}: {}", s.imu, a.movement, a.rho)
+                }
                 // Table 1: 0.53-0.84 for the movements.
                 MovementKind::Functional => {
-                    assert!((0.5..0.9).contains(&a.rho), "{} {}: {}", s.imu, a.movement, a.rho)
+                    assert!(
+                        (0.5..0.9).contains(&a.rho),
+                        "{} {}: {}",
+                        s.imu,
+                        a.movement,
+                        a.rho
+                    )
                 }
             }
             assert!(a.residual_lm_deg <= 180.0 && a.rho >= 1.0 / 3.0);
@@ -114,17 +122,22 @@ fn rho_near_one_for_postures_lower_for_sloppy_movements() {
     // gives 1; with gyroscope noise the slow readings at each turn-around point
     // anywhere, which keeps even a clean movement's rho well below a posture's.
     let rho = |wobble: f64, noise: f64| {
-        let mut c = CalibSimConfig::default();
-        c.gyro_noise_deg_s = noise;
-        c.moving = Sloppiness {
-            wobble_deg: wobble,
-            bias_deg: 0.0,
+        let c = CalibSimConfig {
+            gyro_noise_deg_s: noise,
+            moving: Sloppiness {
+                wobble_deg: wobble,
+                bias_deg: 0.0,
+            },
+            ..CalibSimConfig::default()
         };
         let (_, cal) = run(&c);
         cal.segment("upper_back").unwrap().axis("TR").unwrap().rho
     };
     assert!(rho(0.0, 0.0) > 0.999);
-    let r: Vec<f64> = [0.0, 10.0, 20.0, 35.0].iter().map(|&w| rho(w, 1.0)).collect();
+    let r: Vec<f64> = [0.0, 10.0, 20.0, 35.0]
+        .iter()
+        .map(|&w| rho(w, 1.0))
+        .collect();
     eprintln!("TR rho for wobble 0/10/20/35 deg: {r:.3?}");
     assert!(r.windows(2).all(|w| w[1] < w[0]), "{r:?}");
 }
@@ -215,6 +228,7 @@ fn applying_the_calibration_gives_the_segment_orientation() {
     let applied = AppliedCalibration {
         file: "c.toml".into(),
         sha256: String::new(),
+        text: String::new(),
         protocol: "ricci2014".into(),
         imus: vec![
             AppliedRotation {
