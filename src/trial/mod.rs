@@ -10,6 +10,9 @@ use serde::{Deserialize, Serialize};
 
 mod error;
 mod io;
+pub mod mapping;
+pub mod xsens;
+pub mod xsens_trial;
 
 pub use error::TrialError;
 pub use io::*;
@@ -46,6 +49,21 @@ pub enum TrialFormat {
     EulerCsv,
     /// OpenSim orientation `.sto` (OpenSense), tab-separated `w,x,y,z` cells.
     Sto,
+    /// Xsens MT Manager exports, one `.txt` per sensor, named by a mapping XML or
+    /// a folder (read only; corrected trials are written as `.sto`).
+    #[value(skip)]
+    Xsens,
+}
+
+impl TrialFormat {
+    /// The format a corrected trial is written in by default: the input's own,
+    /// or `.sto` (what OpenSense makes of them) for Xsens exports.
+    pub fn output_default(self) -> TrialFormat {
+        match self {
+            TrialFormat::Xsens => TrialFormat::Sto,
+            f => f,
+        }
+    }
 }
 
 impl Trial {

@@ -159,7 +159,12 @@ pub fn save_variant(
     limits: &LimitTable,
     limits_source: &str,
 ) -> Msg {
-    let output = default_output(path, correction.variant, loaded.format, loaded.gzip);
+    let output = default_output(
+        path,
+        correction.variant,
+        loaded.format.output_default(),
+        loaded.gzip,
+    );
     let req = SaveRequest {
         input: path,
         input_format: loaded.format,
@@ -169,7 +174,7 @@ pub fn save_variant(
         limits,
         limits_source,
         output: &output,
-        output_format: loaded.format,
+        output_format: loaded.format.output_default(),
         sidecar: None,
     };
     let shown = output
