@@ -108,18 +108,24 @@ impl Trial {
     }
 }
 
-/// The built-in model that recognises most IMUs of the trial at `path` (from
-/// its header only); the first built-in model when none recognises any.
+/// The built-in model that fits the trial at `path` best (from its header or
+/// mapping only): the one that recognises most of its IMUs, and among those the
+/// one with fewest IMUs the trial lacks (so an 8-sensor OpenSense trial gets
+/// `opensense_lower`, not the 12-IMU `opensim`); the first built-in model when
+/// none recognises any.
 pub fn detect_model(path: &std::path::Path) -> crate::model::Model {
     use crate::model::{Model, BUILTIN_MODELS};
-    let mut best: Option<(usize, Model)> = None;
+    let mut best: Option<((usize, usize), Model)> = None;
     for (name, _) in BUILTIN_MODELS {
         let model = Model::builtin(name).expect("built-in model is valid");
         let known = read_trial_header(path, &model)
             .map(|h| h.imus.iter().filter(|i| model.imus.contains(i)).count())
             .unwrap_or(0);
-        if best.as_ref().is_none_or(|(k, _)| known > *k) {
-            best = Some((known, model));
+        let lacking = model.imus.len() - known.min(model.imus.len());
+        // Larger is better: most known first, then fewest lacking.
+        let score = (known, usize::MAX - lacking);
+        if best.as_ref().is_none_or(|(s, _)| known > 0 && score > *s) {
+            best = Some((score, model));
         }
     }
     best.expect("there are built-in models").1
