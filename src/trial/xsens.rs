@@ -289,7 +289,7 @@ fn orientation(
         OrientationColumns::Quaternion => {
             let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]).sqrt();
             let off = (n - 1.0).abs();
-            if !(off <= NORM_TOLERANCE) {
+            if off.is_nan() || off > NORM_TOLERANCE {
                 return Err(TrialError::at(
                     origin,
                     line,
@@ -310,7 +310,7 @@ fn orientation(
         OrientationColumns::Matrix => {
             let m = Matrix3::from_row_slice(&v);
             let off = (m.transpose() * m - Matrix3::identity()).abs().max();
-            if !(off <= MATRIX_TOLERANCE) || m.determinant() <= 0.0 {
+            if off.is_nan() || off > MATRIX_TOLERANCE || m.determinant() <= 0.0 {
                 return Err(TrialError::at(
                     origin,
                     line,

@@ -153,7 +153,7 @@ fn check_time_and_count(
             line,
             1,
             format!(
-                "expected the first column to be 'time' (or 'time_s'), seconds, found {}",
+                "expected the first column to be 'time', found {} ('time_s' is accepted too; seconds)",
                 show(first)
             ),
         ));
