@@ -13,6 +13,7 @@ use super::{
     Cancelled, Correction, HeadingWindow, ImuHeading, JointResult, RunControl, SkippedJoint,
     Variant, WindowSolution,
 };
+use crate::baselines;
 use crate::limits::{JointLimits, LimitTable, Settings};
 use crate::model::{Joint, Model};
 use crate::rotation::{angle_deg, canonical, quat_from_wxyz, wxyz, Quat};
@@ -154,13 +155,14 @@ fn run(
                         p(d, total);
                     }
                 };
-                let result = |windows| JointResult {
+                let result = |windows, baseline| JointResult {
                     joint: joint.name.clone(),
                     proximal: joint.proximal.clone(),
                     distal: joint.distal.clone(),
                     lambda2: lim.lambda2,
                     parent_corrected,
                     windows,
+                    baseline,
                 };
                 if variant.heading() {
                     if control.cancelled() {
@@ -177,23 +179,38 @@ fn run(
                     let (sol, heading, orientation) =
                         solve_heading(&trial.time_s, &problem, &joint.name, &joint.distal);
                     windows.iter().for_each(|_| progress());
-                    return Ok((*k, result(sol), Applied::Kept(orientation), Some(heading)));
+                    let applied = Applied::Kept(orientation);
+                    return Ok((*k, result(sol, None), applied, Some(heading)));
                 }
                 let measured: Vec<Quat> = parent
                     .iter()
                     .zip(child)
                     .map(|(p, c)| p.inverse() * c)
                     .collect();
-                let sol = solve_windows(
-                    &trial.time_s,
-                    &measured,
-                    &windows,
-                    lim,
-                    settings.lambda1,
-                    control,
-                    &progress,
-                )?;
-                Ok((*k, result(sol.windows), Applied::Series(sol.series), None))
+                let (sol, baseline) = match baselines::method_for(variant, &joint.kind) {
+                    Some(method) => solve_baseline(
+                        method,
+                        &trial.time_s,
+                        &measured,
+                        &windows,
+                        control,
+                        &progress,
+                    )?,
+                    None => (
+                        solve_windows(
+                            &trial.time_s,
+                            &measured,
+                            &windows,
+                            lim,
+                            settings.lambda1,
+                            control,
+                            &progress,
+                        )?,
+                        None,
+                    ),
+                };
+                let applied = Applied::Series(sol.series);
+                Ok((*k, result(sol.windows, baseline), applied, None))
             })
             .collect::<Result<_, Cancelled>>()?;
         for (k, result, applied, heading) in solved {
@@ -289,6 +306,27 @@ fn solve_heading(
     let series = heading_series(time_s, &centres, &fit.headings_deg);
     let orientation = apply(problem.child, &c, &series, problem.vertical);
     (windows, heading, orientation)
+}
+
+/// Solves one joint with a baseline method (Rivest, Mueller) instead of the ACM.
+fn solve_baseline(
+    method: baselines::Method,
+    time_s: &[f64],
+    measured: &[Quat],
+    windows: &[Window],
+    control: &RunControl,
+    progress: &(dyn Fn() + Sync),
+) -> Result<(JointSolution, Option<baselines::BaselineRecord>), Cancelled> {
+    if control.cancelled() {
+        return Err(Cancelled);
+    }
+    let b = baselines::solve_joint(method, time_s, measured, windows);
+    windows.iter().for_each(|_| progress());
+    let sol = JointSolution {
+        windows: b.windows,
+        series: b.series,
+    };
+    Ok((sol, Some(b.record)))
 }
 
 /// Solves one joint: the measured joint rotations `Rm_i` (parent' to child), per sample.

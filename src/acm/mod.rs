@@ -43,6 +43,10 @@ pub enum Variant {
     Drift,
     /// Windows + slerp + the centroid term (lambda2 from the table).
     DriftCentroid,
+    /// Rivest (2005) for the knees, per drift window; `drift-centroid` elsewhere.
+    Rivest,
+    /// Mueller et al. (2017) axes for the elbows; `drift-centroid` elsewhere.
+    Mueller,
     /// One constant correction per IMU plus a heading correction about the
     /// global vertical per window: `G_R' = R_up(-h(t)) G_R C`; no centroid term.
     DriftHeading,
@@ -52,10 +56,12 @@ pub enum Variant {
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 5] = [
+    pub const ALL: [Variant; 7] = [
         Variant::Basic,
         Variant::Drift,
         Variant::DriftCentroid,
+        Variant::Rivest,
+        Variant::Mueller,
         Variant::DriftHeading,
         Variant::DriftHeadingCentroid,
     ];
@@ -66,19 +72,10 @@ impl Variant {
             Variant::Basic => "basic",
             Variant::Drift => "drift",
             Variant::DriftCentroid => "drift-centroid",
+            Variant::Rivest => "rivest",
+            Variant::Mueller => "mueller",
             Variant::DriftHeading => "drift-heading",
             Variant::DriftHeadingCentroid => "drift-heading-centroid",
-        }
-    }
-
-    /// A name of at most 6 characters for narrow columns.
-    pub fn short_name(self) -> &'static str {
-        match self {
-            Variant::Basic => "basic",
-            Variant::Drift => "drift",
-            Variant::DriftCentroid => "d+c",
-            Variant::DriftHeading => "d+h",
-            Variant::DriftHeadingCentroid => "d+h+c",
         }
     }
 
@@ -94,7 +91,13 @@ impl Variant {
 
     /// Uses the table's centroid term.
     pub fn centroid(self) -> bool {
-        matches!(self, Variant::DriftCentroid | Variant::DriftHeadingCentroid)
+        matches!(
+            self,
+            Variant::DriftCentroid
+                | Variant::Rivest
+                | Variant::Mueller
+                | Variant::DriftHeadingCentroid
+        )
     }
 
     /// Models drift as a heading rotation about the global vertical.
@@ -143,6 +146,10 @@ pub struct JointResult {
     /// its own joint was skipped).
     pub parent_corrected: bool,
     pub windows: Vec<WindowSolution>,
+    /// What a baseline method found, for the joints a baseline variant
+    /// corrects (`rivest`, `mueller`); absent for ACM joints.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<crate::baselines::BaselineRecord>,
 }
 
 /// The heading correction of one window of a heading-drift variant.
