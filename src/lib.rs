@@ -5,9 +5,11 @@
 //! `acmw` binary are thin layers over it.
 
 pub mod acm;
+pub mod analysis;
 pub mod limits;
 pub mod metrics;
 pub mod model;
+pub mod plot;
 pub mod report;
 pub mod rotation;
 pub mod save;

@@ -31,6 +31,7 @@ use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 
 mod motion;
+pub mod swing;
 #[cfg(test)]
 mod tests;
 
@@ -47,7 +48,12 @@ pub const KNEE_IMUS: [&str; 2] = ["l_thigh", "l_calf"];
 /// Default random misalignment angles, degrees.
 pub const RANDOM_MISALIGNMENT_DEG: [f64; 2] = [5.0, 30.0];
 /// Names accepted by [`preset`].
-pub const PRESETS: [&str; 3] = ["knee_calf_z15", "full_body_clean", "full_body_drift"];
+pub const PRESETS: [&str; 4] = [
+    "knee_calf_z15",
+    "full_body_clean",
+    "full_body_drift",
+    "full_body_swing",
+];
 
 /// What to simulate, for how long, and which errors to put into the sensors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -86,6 +92,9 @@ pub enum SimKind {
     /// The 13 IMUs of `infant13`: a moving base and smooth joint angles, mostly
     /// inside Table 3-2, around the Table 3-3 centroids (or the middle of the range).
     FullBody,
+    /// The 13 IMUs of `infant13`, every joint axis one sinusoid over a known
+    /// range (see [`swing`]): clean trials whose limits and centroids are known.
+    Swing,
 }
 
 /// Which IMU of the knee test is misaligned.
@@ -211,7 +220,7 @@ impl SimConfig {
     pub fn imus(&self, model: &Model) -> Vec<String> {
         match self.kind {
             SimKind::Knee { .. } => KNEE_IMUS.iter().map(|s| s.to_string()).collect(),
-            SimKind::FullBody => model.imus.clone(),
+            SimKind::FullBody | SimKind::Swing => model.imus.clone(),
         }
     }
 
@@ -301,7 +310,8 @@ impl SimConfig {
 /// 5 min, 50 Hz, no noise), `full_body_clean` (13 IMUs, 90 s, 50 Hz, seed 1,
 /// random 5-30 degree misalignment, 0.3 degree noise, no drift), `full_body_drift`
 /// (as clean but 300 s, seed 2, heading drift on `l_calf` from 60 s at 0.05 deg/s
-/// and on `r_upper_arm` from 30 s at 0.08 deg/s).
+/// and on `r_upper_arm` from 30 s at 0.08 deg/s), `full_body_swing` (13 IMUs,
+/// [`SimKind::Swing`], 60 s, 50 Hz, seed 1, no misalignment, 0.3 degree noise).
 pub fn preset(name: &str) -> Option<SimConfig> {
     match name {
         "knee_calf_z15" => Some(SimConfig::knee(KneeImu::Calf, KneeAxis::Z, 15.0)),
@@ -323,6 +333,12 @@ pub fn preset(name: &str) -> Option<SimConfig> {
                 },
             ],
             ..SimConfig::full_body(2)
+        }),
+        "full_body_swing" => Some(SimConfig {
+            kind: SimKind::Swing,
+            duration_s: 60.0,
+            misalignment: Misalignment::None,
+            ..SimConfig::full_body(1)
         }),
         _ => None,
     }
@@ -354,6 +370,7 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
     let segments: Vec<(String, Vec<Quat>)> = match config.kind {
         SimKind::Knee { .. } => knee_segments(&time_s),
         SimKind::FullBody => full_body_segments(&model, config.seed, &time_s),
+        SimKind::Swing => swing::segments(&model, config.seed, &time_s),
     };
 
     let misalignments = misalignments(config, &model, &segments);
@@ -424,6 +441,7 @@ fn kind_label(kind: &SimKind) -> String {
     match kind {
         SimKind::Knee { .. } => "simulated-knee".into(),
         SimKind::FullBody => "simulated-full-body".into(),
+        SimKind::Swing => "simulated-swing".into(),
     }
 }
 
@@ -453,17 +471,28 @@ fn full_body_segments(model: &Model, seed: u64, time_s: &[f64]) -> Vec<(String, 
         .iter()
         .map(|j| motion::joint_motion(&mut r, &table, j))
         .collect();
+    chain_segments(model, &base, time_s, |k, t| joints[k].angles_at(t))
+}
+
+/// Segment orientations of every IMU of `model`: the base from `base`, each
+/// joint's distal segment as its proximal one times `Rzyx(angles(joint index, t))`.
+fn chain_segments(
+    model: &Model,
+    base: &motion::BaseMotion,
+    time_s: &[f64],
+    angles: impl Fn(usize, f64) -> [f64; 3],
+) -> Vec<(String, Vec<Quat>)> {
     let mut by_imu: BTreeMap<&str, Vec<Quat>> = BTreeMap::new();
     by_imu.insert(
         &model.base,
         time_s.iter().map(|&t| base.orientation_at(t)).collect(),
     );
-    for (j, m) in model.joints.iter().zip(&joints) {
+    for (k, j) in model.joints.iter().enumerate() {
         let prox = &by_imu[j.proximal.as_str()];
         let dist = prox
             .iter()
             .zip(time_s)
-            .map(|(p, &t)| p * rotation::quat_from_euler_zyx_deg(m.angles_at(t)))
+            .map(|(p, &t)| p * rotation::quat_from_euler_zyx_deg(angles(k, t)))
             .collect();
         by_imu.insert(&j.distal, dist);
     }
