@@ -125,7 +125,9 @@ mod tests {
         assert_eq!((z.samples, z.trials), (2, 2));
         let csv = t.to_csv();
         assert!(csv.starts_with("# Centroids by acmw"), "{csv}");
-        assert!(csv.contains("\njoint,axis,centroid_deg,sd_deg,samples,trials\nhip,X,2.00,1.00,2,2\n"));
+        assert!(
+            csv.contains("\njoint,axis,centroid_deg,sd_deg,samples,trials\nhip,X,2.00,1.00,2,2\n")
+        );
         assert!(centroids(&[], TimeSpan::WHOLE).rows.is_empty());
     }
 }

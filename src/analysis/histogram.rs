@@ -227,10 +227,7 @@ mod tests {
             assert_eq!(h.interval_deg, want, "n={n}");
             // It holds at least 90% of the samples, and not one sample more
             // than 90% of each side rounds up to.
-            let inside = v
-                .iter()
-                .filter(|&&x| x >= want[0] && x <= want[1])
-                .count();
+            let inside = v.iter().filter(|&&x| x >= want[0] && x <= want[1]).count();
             assert!(inside as f64 >= 0.9 * n as f64, "n={n}: {inside}");
             assert_eq!(h.counts.iter().sum::<u32>() as usize, n);
         }

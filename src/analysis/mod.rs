@@ -79,6 +79,14 @@ pub struct TrialRef<'a> {
     pub model: &'a Model,
 }
 
+/// The trials, each read with `model`.
+pub fn trial_refs<'a>(trials: &'a [Trial], model: &'a Model) -> Vec<TrialRef<'a>> {
+    trials
+        .iter()
+        .map(|trial| TrialRef { trial, model })
+        .collect()
+}
+
 /// Per joint, in model order of first appearance, the angles inside `span` of
 /// every trial that has the joint's two IMUs. Joints without any sample in
 /// the span are left out.

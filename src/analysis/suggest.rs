@@ -127,19 +127,19 @@ impl Suggestion {
     /// unchanged rows and the rows without samples by name.
     pub fn diff_lines(&self) -> Vec<String> {
         let mut out = vec![format!(
-            "{:<12} {:<4} {:>17} {:>17} {:>8}",
+            "{:<12} {:<4} {:<16} {:<16} {:>8}",
             "joint", "axis", "lower deg", "upper deg", "samples"
         )];
         let arrow = |a: f64, b: f64| {
             if a == b {
-                format!("{a:>6}          ")
+                format!("{a:>6}")
             } else {
-                format!("{a:>6} -> {b:<6}")
+                format!("{a:>6} -> {b}")
             }
         };
         for r in self.rows.iter().filter(|r| r.changed()) {
             out.push(format!(
-                "{:<12} {:<4} {:>17} {:>17} {:>8}",
+                "{:<12} {:<4} {:<16} {:<16} {:>8}",
                 r.joint,
                 axis_name(r.axis),
                 arrow(r.current[0], r.suggested[0]),
@@ -168,10 +168,7 @@ impl Suggestion {
             }
         ));
         if !none.is_empty() {
-            out.push(format!(
-                "no samples, limits kept: {}",
-                none.join(", ")
-            ));
+            out.push(format!("no samples, limits kept: {}", none.join(", ")));
         }
         out
     }
@@ -180,7 +177,9 @@ impl Suggestion {
 /// Why a table could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {
-    #[error("{0}: this is the current table; a suggestion is never written over it (name another file)")]
+    #[error(
+        "{0}: this is the current table; a suggestion is never written over it (name another file)"
+    )]
     Original(PathBuf),
     #[error("{path}: cannot write: {source}")]
     Io {
@@ -191,7 +190,11 @@ pub enum WriteError {
 
 /// Writes `table` to `out` atomically (an existing file is kept as `.bak`),
 /// refusing when `out` is the current table `original`.
-pub fn write_table(table: &LimitTable, out: &Path, original: Option<&Path>) -> Result<(), WriteError> {
+pub fn write_table(
+    table: &LimitTable,
+    out: &Path,
+    original: Option<&Path>,
+) -> Result<(), WriteError> {
     if let Some(orig) = original {
         if same_file(out, orig) {
             return Err(WriteError::Original(out.to_path_buf()));

@@ -8,8 +8,10 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
+mod analysis;
 mod common;
 mod correct;
+mod plot;
 mod render;
 mod report;
 mod simulate;
@@ -50,6 +52,12 @@ pub enum Command {
     Simulate(simulate::SimulateArgs),
     /// Print a workbench screen as text (trials, trial, compare, limits, help).
     Render(render::RenderArgs),
+    /// Suggest a limit table from the 90% intervals of clean trials; prints the diff.
+    SuggestLimits(analysis::SuggestArgs),
+    /// Mean joint angles over the first 30 s of trials, as a centroid table.
+    Centroids(analysis::CentroidArgs),
+    /// Write a figure as SVG or PNG: traces or histogram.
+    Plot(plot::PlotArgs),
 }
 
 /// Runs the parsed command line; returns the process exit code.
@@ -59,6 +67,9 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
         Some(Command::Render(a)) => render::run(a, &cli.theme),
+        Some(Command::SuggestLimits(a)) => analysis::run_suggest(a),
+        Some(Command::Centroids(a)) => analysis::run_centroids(a),
+        Some(Command::Plot(a)) => plot::run(a),
         None => workbench(cli.dir, &cli.theme),
     };
     match result {

@@ -53,7 +53,6 @@ pub fn envelope(
     out
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -20,7 +20,10 @@ pub struct Histograms<'a> {
 impl Figure for Histograms<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         if self.hist.axes.iter().all(Option::is_none) {
-            return Err(PlotError::Empty(format!("no samples of {}", self.hist.name)));
+            return Err(PlotError::Empty(format!(
+                "no samples of {}",
+                self.hist.name
+            )));
         }
         let root = root.titled(&self.title, (FONT, 20)).map_err(draw_err)?;
         let panels = root.split_evenly((1, 3));
@@ -70,6 +73,8 @@ fn panel_of<DB: DrawingBackend>(
         .x_desc("deg")
         .y_desc("samples")
         .label_style((FONT, 11))
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
         .draw()
         .map_err(draw_err)?;
     let bars = h

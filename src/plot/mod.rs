@@ -173,12 +173,17 @@ mod tests {
         let e = Format::from_path(Path::new("a.pdf")).unwrap_err();
         assert!(e.to_string().contains("a.pdf: expected"), "{e}");
         let svg = to_svg(&Box1, (40, 30)).unwrap();
-        assert!(svg.starts_with("<svg") && svg.contains(">\nhi\n</text>"), "{svg}");
+        assert!(
+            svg.starts_with("<svg") && svg.contains(">\nhi\n</text>"),
+            "{svg}"
+        );
         let png = to_png(&Box1, (40, 30)).unwrap();
         assert_eq!(&png[1..4], b"PNG");
         // The text was rasterised with the shipped font: left of the box,
         // where only the text can be, some pixel is not white.
-        let mut dec = png::Decoder::new(std::io::Cursor::new(&png)).read_info().unwrap();
+        let mut dec = png::Decoder::new(std::io::Cursor::new(&png))
+            .read_info()
+            .unwrap();
         let mut rgb = vec![0; dec.output_buffer_size()];
         dec.next_frame(&mut rgb).unwrap();
         let px = |x: usize, y: usize| &rgb[(y * 40 + x) * 3..(y * 40 + x) * 3 + 3];

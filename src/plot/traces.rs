@@ -31,9 +31,7 @@ impl Figure for Traces<'_> {
         if self.raw.is_empty() || self.time_s.len() != self.raw.len() {
             return Err(PlotError::Empty("no samples of the joint".into()));
         }
-        let root = root
-            .titled(&self.title, (FONT, 20))
-            .map_err(draw_err)?;
+        let root = root.titled(&self.title, (FONT, 20)).map_err(draw_err)?;
         let panels = root.split_evenly((3, 1));
         for (axis, panel) in panels.iter().enumerate() {
             self.panel(panel, axis)?;
@@ -68,7 +66,7 @@ impl Traces<'_> {
             (lo, hi) = (-1.0, 1.0);
         }
         let pad = ((hi - lo) * 0.05).max(0.5);
-        let mut caption = format!("{}", axis_name(axis));
+        let mut caption = axis_name(axis).to_string();
         if let Some([l, h]) = range {
             caption.push_str(&format!("  limits [{l}, {h}]"));
         }
@@ -83,7 +81,11 @@ impl Traces<'_> {
             .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
             .map_err(draw_err)?;
         let mut mesh = chart.configure_mesh();
-        mesh.disable_mesh().y_desc("deg").label_style((FONT, 11));
+        mesh.disable_mesh()
+            .y_desc("deg")
+            .label_style((FONT, 11))
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0}"));
         if axis == 2 {
             mesh.x_desc("time (s)");
         }
@@ -107,9 +109,8 @@ impl Traces<'_> {
             .draw_series(LineSeries::new(raw, colours::RAW.stroke_width(1)))
             .map_err(draw_err)?;
         if axis == 0 {
-            s.label("uncorrected").legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], colours::RAW)
-            });
+            s.label("uncorrected")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colours::RAW));
         }
         if let Some((label, cor)) = &self.corrected {
             let pts = envelope(self.time_s, origin, |i| cor[i][axis], t0, t1, columns);

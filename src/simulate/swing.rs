@@ -90,9 +90,9 @@ mod tests {
             for axis in 0..3 {
                 let [lo, hi] = range_deg(&table, j, axis);
                 let v: Vec<f64> = a.iter().map(|x| x[axis]).collect();
-                let (min, max) = v.iter().fold((f64::MAX, f64::MIN), |m, &x| {
-                    (m.0.min(x), m.1.max(x))
-                });
+                let (min, max) = v
+                    .iter()
+                    .fold((f64::MAX, f64::MIN), |m, &x| (m.0.min(x), m.1.max(x)));
                 // Whole cycles of 2-10 s in 60 s reach the extremes within
                 // the sampling step (at most 0.3 deg for these amplitudes).
                 assert!(min >= lo - 1e-6 && max <= hi + 1e-6, "{} {axis}", j.name);
