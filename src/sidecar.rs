@@ -145,7 +145,7 @@ pub fn default_output(input: &Path, variant: Variant, format: TrialFormat, gzip:
     let name = input.file_name().unwrap_or_default().to_string_lossy();
     let lower = name.to_ascii_lowercase();
     let mut stem_len = name.len();
-    for ext in [".gz", ".csv", ".sto"] {
+    for ext in [".gz", ".csv", ".sto", ".xml"] {
         if lower[..stem_len].ends_with(ext) {
             stem_len -= ext.len();
         }
@@ -185,7 +185,7 @@ pub struct SaveRequest<'a> {
 impl SaveRequest<'_> {
     /// The sidecar record of this correction (reads the input file for its hash).
     pub fn sidecar(&self) -> anyhow::Result<Sidecar> {
-        let bytes = std::fs::read(self.input)
+        let bytes = crate::trial::input_bytes(self.input)
             .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", self.input.display()))?;
         let input = InputRecord {
             file: self.input.display().to_string(),

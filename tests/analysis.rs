@@ -49,7 +49,12 @@ fn suggested_limits_land_within_3_deg_of_the_true_ranges() {
     // (at most 0.8 deg here) inside its extremes, outward rounding adds
     // under 1 deg, noise about 0.5 deg near the Euler singularity.
     let mut worst: f64 = 0.0;
-    for r in &s.rows {
+    // Rows of joints infant13 does not have (the 16-segment model's) keep
+    // their limits.
+    for r in s.rows.iter().filter(|r| r.samples == 0) {
+        assert!(!r.changed() && model.joints.iter().all(|j| j.kind != r.joint));
+    }
+    for r in s.rows.iter().filter(|r| r.samples > 0) {
         let joint = model
             .joints
             .iter()
@@ -82,7 +87,9 @@ fn suggested_limits_land_within_3_deg_of_the_true_ranges() {
     let diff = s.diff_lines();
     let changed = s.rows.iter().filter(|r| r.changed()).count();
     assert!(changed >= 18, "{diff:#?}");
-    assert_eq!(diff.len(), 1 + changed + 1, "{diff:#?}");
+    let without = usize::from(s.rows.iter().any(|r| r.samples == 0));
+    assert_eq!(diff.len(), 1 + changed + 1 + without, "{diff:#?}");
+    assert_eq!(s.rows.iter().filter(|r| r.samples > 0).count(), 21);
     assert!(
         diff.iter()
             .any(|l| l.starts_with("knee") && l.contains("130 -> 80")),

@@ -58,7 +58,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             eprintln!("warning: {w}");
         }
     }
-    let format = args.format.unwrap_or(in_format);
+    let format = args.format.unwrap_or(in_format.output_default());
     let output = args
         .output
         .clone()
