@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
 mod analysis;
+mod calibrate;
 mod common;
 mod correct;
 mod plot;
@@ -58,6 +59,8 @@ pub enum Command {
     Centroids(analysis::CentroidArgs),
     /// Write a figure as SVG or PNG: traces or histogram.
     Plot(plot::PlotArgs),
+    /// Functional calibration of a recording (Ricci et al. 2014): rho table, residuals, calibration file.
+    Calibrate(calibrate::CalibrateArgs),
 }
 
 /// Runs the parsed command line; returns the process exit code.
@@ -70,6 +73,7 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::SuggestLimits(a)) => analysis::run_suggest(a),
         Some(Command::Centroids(a)) => analysis::run_centroids(a),
         Some(Command::Plot(a)) => plot::run(a),
+        Some(Command::Calibrate(a)) => calibrate::run(a),
         None => workbench(cli.dir, &cli.theme),
     };
     match result {
@@ -111,5 +115,6 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
         c.is::<acm_workbench::trial::TrialError>()
             || c.is::<acm_workbench::limits::LimitsError>()
             || c.is::<acm_workbench::model::ModelError>()
+            || c.is::<acm_workbench::calibration::CalibrationError>()
     })
 }
