@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Screen: trials, trial, compare, limits or help.
+    /// Screen: trials, trial, compare, limits, help or calibration.
     #[arg(value_parser = SCREENS)]
     pub screen: String,
     /// Folder of trials [default: ./sample_trials].
@@ -33,7 +33,7 @@ pub struct RenderArgs {
     pub color: bool,
 }
 
-fn parse_size(s: &str) -> Result<(u16, u16), String> {
+pub fn parse_size(s: &str) -> Result<(u16, u16), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WxH, found '{s}'"))?;
