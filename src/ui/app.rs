@@ -153,6 +153,7 @@ pub enum Screen {
     Trial,
     Compare,
     Limits,
+    Calibration,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -407,6 +408,8 @@ pub struct App {
     /// A message in the status bar: (text, is_error).
     pub message: Option<(String, bool)>,
     pub quit: bool,
+    /// The calibration screen (`super::calibration`).
+    pub calib: super::calibration::CalibState,
 }
 
 /// What the runtime should do.
@@ -437,6 +440,8 @@ pub enum Effect {
         table_csv: String,
         settings_toml: String,
     },
+    /// Read and calibrate the calibration recordings of this folder.
+    Calibrations { dir: PathBuf },
     /// Ask for `Msg::RecorrectDue` after the debounce delay (a newer request
     /// replaces an older one).
     Debounce,
@@ -485,6 +490,8 @@ pub enum Msg {
     /// The limit files on disk differ from what the workbench last loaded or saved.
     LimitsOnDisk(LimitTable, SettingsFile),
     RecorrectDue,
+    /// The calibration recordings of the folder, read and calibrated (protocol label).
+    Calibrations(Vec<super::calibration::CalibEntry>, String),
 }
 
 impl App {
@@ -511,6 +518,7 @@ impl App {
             limits_from: Screen::Trials,
             message: None,
             quit: false,
+            calib: Default::default(),
         };
         for f in files {
             let path = app.dir.join(&f);
@@ -804,6 +812,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
         }
         Msg::RecorrectDue => recorrect_now(app),
+        Msg::Calibrations(entries, protocol) => {
+            super::calibration::loaded(app, entries, protocol);
+            vec![]
+        }
     }
 }
 
@@ -1021,6 +1033,7 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Trial => trial_action(app, a),
         Screen::Compare => compare_action(app, a),
         Screen::Limits => limits_action(app, a),
+        Screen::Calibration => super::calibration::action(app, a),
     }
 }
 
@@ -1042,6 +1055,7 @@ fn trials_action(app: &mut App, a: Action) -> Vec<Effect> {
             app.sort_trials();
         }
         Action::Variant => next_variant(app),
+        Action::Calibration => return super::calibration::enter(app),
         Action::Enter | Action::Right => {
             let Some(e) = app.selected_entry() else {
                 return vec![];
