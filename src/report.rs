@@ -1,7 +1,9 @@
 //! A trial's figures before and after each correction variant, as a data
 //! structure (for JSON and screens) and as aligned text tables (for terminals).
 
-use crate::acm::{correct_trial, Cancelled, Correction, RunControl, SkippedJoint, Variant};
+use crate::acm::{
+    correct_trial, Cancelled, Correction, ImuHeading, RunControl, SkippedJoint, Variant,
+};
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
@@ -15,6 +17,9 @@ pub struct VariantReport {
     pub variant: Variant,
     pub joints: Vec<JointFigures>,
     pub skipped: Vec<SkippedJoint>,
+    /// Estimated heading drift per IMU (heading-drift variants only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub headings: Vec<ImuHeading>,
 }
 
 /// A trial's figures, uncorrected and per variant.
@@ -75,6 +80,7 @@ impl ReportInput<'_> {
                         self.limits,
                     ),
                     skipped: c.skipped.clone(),
+                    headings: c.headings.clone(),
                 })
                 .collect(),
             warnings: t.warnings.clone(),
@@ -159,6 +165,60 @@ fn table(
     }
 }
 
+/// An IMU's heading counts as drift above this, degrees.
+const HEADING_SHOWN_DEG: f64 = 0.05;
+
+/// The estimated heading drift of a heading-drift variant: per window centre
+/// (rows) and drifting IMU (columns) the heading in degrees and its rate since
+/// the previous centre in degrees per second.
+fn heading_table(out: &mut String, v: &VariantReport) {
+    let shown: Vec<&ImuHeading> = v
+        .headings
+        .iter()
+        .filter(|h| h.max_abs_heading_deg() > HEADING_SHOWN_DEG)
+        .collect();
+    let vertical = v.headings.first().map_or("z-up", |h| h.vertical.name());
+    let _ = writeln!(
+        out,
+        "\nEstimated heading drift, {}: deg about the vertical ({vertical}) | deg/s since the previous window",
+        v.variant
+    );
+    if shown.is_empty() {
+        let _ = writeln!(out, "no IMU drifted by more than {HEADING_SHOWN_DEG} deg");
+        return;
+    }
+    let _ = write!(out, "{:>8}", "time s");
+    for h in &shown {
+        let _ = write!(out, "  {:>18}", h.imu);
+    }
+    out.push('\n');
+    for (k, w) in shown[0].windows.iter().enumerate() {
+        let _ = write!(out, "{:>8.1}", w.centre_s);
+        for h in &shown {
+            let hw = &h.windows[k];
+            let rate = hw
+                .rate_deg_s
+                .map_or("-".to_string(), |r| format!("{r:+.4}"));
+            let _ = write!(out, "  {:>8.2} | {rate:>7}", hw.heading_deg);
+        }
+        out.push('\n');
+    }
+    let _ = write!(out, "{:>8}", "mean/s");
+    for h in &shown {
+        let _ = write!(out, "  {:>18}", format!("{:+.4}", h.mean_rate_deg_s()));
+    }
+    out.push('\n');
+    let still: Vec<&str> = v
+        .headings
+        .iter()
+        .filter(|h| h.max_abs_heading_deg() <= HEADING_SHOWN_DEG)
+        .map(|h| h.imu.as_str())
+        .collect();
+    if !still.is_empty() {
+        let _ = writeln!(out, "no heading drift found: {}", still.join(", "));
+    }
+}
+
 /// The report as aligned text tables for a terminal.
 pub fn format_text(r: &TrialReport) -> String {
     let mut out = String::new();
@@ -240,6 +300,9 @@ pub fn format_text(r: &TrialReport) -> String {
                     .map(|t| format!("{:.2}", t.mean_correction_error_deg))
             },
         );
+    }
+    for v in r.variants.iter().filter(|v| v.variant.heading()) {
+        heading_table(&mut out, v);
     }
     out
 }
