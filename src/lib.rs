@@ -8,6 +8,7 @@ pub mod acm;
 pub mod limits;
 pub mod metrics;
 pub mod model;
+pub mod pose;
 pub mod report;
 pub mod rotation;
 pub mod save;
