@@ -40,11 +40,19 @@ pub enum Variant {
     Drift,
     /// Windows + slerp + the centroid term (lambda2 from the table).
     DriftCentroid,
+    /// IMU inverse kinematics (`crate::ik`): joint coordinates with the
+    /// model's degrees of freedom and hard limits; not the ACM.
+    Ik,
 }
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 3] = [Variant::Basic, Variant::Drift, Variant::DriftCentroid];
+    pub const ALL: [Variant; 4] = [
+        Variant::Basic,
+        Variant::Drift,
+        Variant::DriftCentroid,
+        Variant::Ik,
+    ];
 
     /// The name used on the command line, in files and on screen.
     pub fn name(self) -> &'static str {
@@ -52,6 +60,7 @@ impl Variant {
             Variant::Basic => "basic",
             Variant::Drift => "drift",
             Variant::DriftCentroid => "drift-centroid",
+            Variant::Ik => "ik",
         }
     }
 
@@ -62,7 +71,7 @@ impl Variant {
 
     /// Solves per window (true) or once for the whole trial (false).
     pub fn windowed(self) -> bool {
-        !matches!(self, Variant::Basic)
+        matches!(self, Variant::Drift | Variant::DriftCentroid)
     }
 
     /// Uses the table's centroid term.
@@ -131,6 +140,8 @@ pub struct Correction {
     pub joints: Vec<JointResult>,
     /// Joints of the model that were not corrected.
     pub skipped: Vec<SkippedJoint>,
+    /// The joint coordinates of the `ik` variant (None for the others).
+    pub ik: Option<std::sync::Arc<crate::ik::IkRun>>,
 }
 
 impl Correction {

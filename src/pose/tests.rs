@@ -178,6 +178,28 @@ fn heading_correction_makes_joint_angles_independent_of_facing() {
             };
             let d = max_angle_difference(&run(&a), &run(&b), &model);
             assert!(d < 1e-6, "alpha {alpha}, at {at}, basic: {d} deg");
+            // And the inverse-kinematics coordinates.
+            let ik = |t: &Trial| {
+                correct_trial(
+                    t,
+                    &model,
+                    &table,
+                    &settings,
+                    Variant::Ik,
+                    &RunControl::default(),
+                )
+                .unwrap()
+                .ik
+                .unwrap()
+            };
+            let (ia, ib) = (ik(&a), ik(&b));
+            let d = ia
+                .values_deg
+                .iter()
+                .zip(&ib.values_deg)
+                .map(|(x, y)| wrap180(x - y).abs())
+                .fold(0.0, f64::max);
+            assert!(d < 1e-6, "alpha {alpha}, at {at}, ik: {d} deg");
         }
     }
     // Without the heading correction the offsets turn with the subject and the
