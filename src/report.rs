@@ -2,9 +2,11 @@
 //! structure (for JSON and screens) and as aligned text tables (for terminals).
 
 use crate::acm::{correct_trial, Cancelled, Correction, RunControl, SkippedJoint, Variant};
+use crate::ik::IkSummary;
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
+use crate::pose::PoseRecord;
 use crate::trial::Trial;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -15,6 +17,9 @@ pub struct VariantReport {
     pub variant: Variant,
     pub joints: Vec<JointFigures>,
     pub skipped: Vec<SkippedJoint>,
+    /// The `ik` variant's solver figures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ik: Option<IkSummary>,
 }
 
 /// A trial's figures, uncorrected and per variant.
@@ -34,6 +39,9 @@ pub struct TrialReport {
     pub uncorrected: Vec<JointFigures>,
     pub variants: Vec<VariantReport>,
     pub warnings: Vec<String>,
+    /// The pose calibration the trial went through before correction.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pose_calibration: Option<PoseRecord>,
 }
 
 /// Inputs of a report.
@@ -75,9 +83,11 @@ impl ReportInput<'_> {
                         self.limits,
                     ),
                     skipped: c.skipped.clone(),
+                    ik: c.ik.as_ref().map(|r| r.summary()),
                 })
                 .collect(),
             warnings: t.warnings.clone(),
+            pose_calibration: None,
         }
     }
 
@@ -182,6 +192,13 @@ pub fn format_text(r: &TrialReport) -> String {
     for w in &r.warnings {
         let _ = writeln!(out, "warning: {w}");
     }
+    if let Some(p) = &r.pose_calibration {
+        let _ = writeln!(
+            out,
+            "pose calibration at {} s ({} samples): heading corrected by {:.2} deg; \"uncorrected\" is the calibrated trial",
+            p.calibration.at, p.samples, p.heading_deg
+        );
+    }
     if let Some(v) = r.variants.first().filter(|v| !v.skipped.is_empty()) {
         let list: Vec<String> = v
             .skipped
@@ -241,5 +258,31 @@ pub fn format_text(r: &TrialReport) -> String {
             },
         );
     }
+    for v in &r.variants {
+        if let Some(ik) = &v.ik {
+            ik_text(&mut out, ik);
+        }
+    }
     out
+}
+
+fn ik_text(out: &mut String, s: &IkSummary) {
+    let _ = writeln!(
+        out,
+        "\nInverse kinematics (ik): {} frames, {} coordinates; RMS orientation error per frame {:.3} deg mean, {:.3} max; {:.2} steps per frame (max {})",
+        s.frames,
+        s.coordinates.len(),
+        s.mean_rms_error_deg,
+        s.max_rms_error_deg,
+        s.mean_iterations,
+        s.max_iterations
+    );
+    if !s.pct_at_limit.is_empty() {
+        let list: Vec<String> = s
+            .pct_at_limit
+            .iter()
+            .map(|(c, p)| format!("{c} {p:.1}%"))
+            .collect();
+        let _ = writeln!(out, "frames on a hard limit: {}", list.join(", "));
+    }
 }

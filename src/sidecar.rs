@@ -3,9 +3,12 @@
 //! to reproduce the output exactly.
 
 use crate::acm::{Correction, JointResult, SkippedJoint, Variant};
+use crate::ik::output::{coordinates_path, write_coordinates};
+use crate::ik::IkSummary;
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
+use crate::pose::PoseRecord;
 use crate::save::atomic_write;
 use crate::trial::{write_trial, Trial, TrialFormat};
 use serde::{Deserialize, Serialize};
@@ -57,6 +60,20 @@ pub struct Sidecar {
     pub skipped: Vec<SkippedJoint>,
     pub figures: FiguresRecord,
     pub warnings: Vec<String>,
+    /// The pose calibration applied before the correction, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pose_calibration: Option<PoseRecord>,
+    /// The `ik` variant's figures and its joint-coordinates file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ik: Option<IkRecord>,
+}
+
+/// What an `ik` run wrote besides the orientations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IkRecord {
+    /// The joint-coordinates CSV.
+    pub coordinates_file: String,
+    pub summary: IkSummary,
 }
 
 /// Hex SHA-256 of bytes.
@@ -105,6 +122,8 @@ impl Sidecar {
             skipped: correction.skipped.clone(),
             figures,
             warnings: Vec::new(),
+            pose_calibration: None,
+            ik: None,
         }
     }
 
@@ -168,8 +187,10 @@ pub struct SaveRequest<'a> {
     /// The file the raw trial was read from.
     pub input: &'a Path,
     pub input_format: TrialFormat,
-    /// The raw trial as read.
+    /// The trial as the correction saw it: as read, or pose-calibrated.
     pub trial: &'a Trial,
+    /// The pose calibration that made `trial` from the file, if any.
+    pub pose: Option<&'a PoseRecord>,
     pub correction: &'a Correction,
     pub model: &'a Model,
     pub limits: &'a LimitTable,
@@ -215,6 +236,11 @@ impl SaveRequest<'_> {
             figures,
         );
         s.warnings = self.trial.warnings.clone();
+        s.pose_calibration = self.pose.cloned();
+        s.ik = self.correction.ik.as_ref().map(|run| IkRecord {
+            coordinates_file: coordinates_path(self.output).display().to_string(),
+            summary: run.summary(),
+        });
         Ok(s)
     }
 
@@ -227,6 +253,9 @@ impl SaveRequest<'_> {
         }
         let sidecar = self.sidecar()?;
         write_trial(&self.correction.corrected, self.output, self.output_format)?;
+        if let Some(run) = &self.correction.ik {
+            write_coordinates(run, &coordinates_path(self.output))?;
+        }
         let path = self
             .sidecar
             .map(Path::to_path_buf)

@@ -1,6 +1,6 @@
 //! `acmw report`: the METHOD.md section 6 figures before and after each variant.
 
-use super::common::{load_context, EngineArgs, Progress};
+use super::common::{apply_pose, load_context, EngineArgs, PoseArgs, Progress};
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::report::{format_text, ReportInput};
 use acm_workbench::trial::read_trial;
@@ -20,6 +20,8 @@ pub struct ReportArgs {
     pub json: bool,
     #[command(flatten)]
     pub engine: EngineArgs,
+    #[command(flatten)]
+    pub pose: PoseArgs,
     /// No progress output.
     #[arg(short, long)]
     pub quiet: bool,
@@ -29,6 +31,8 @@ pub struct ReportArgs {
 pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     let ctx = load_context(&args.engine, Some(&args.input))?;
     let trial = read_trial(&args.input, &ctx.model)?;
+    let calibration = args.pose.calibration(&ctx.model);
+    let (trial, pose) = apply_pose(trial, &ctx.model, calibration.as_ref(), &args.input)?;
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {
             let t = t?;
@@ -61,7 +65,8 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         settings: &ctx.settings,
         truth: truth.as_ref().map(|t| &t.segments),
     };
-    let r = input.run(&variants, &control)?;
+    let mut r = input.run(&variants, &control)?;
+    r.pose_calibration = pose;
     progress.finish();
     if args.json {
         println!("{}", serde_json::to_string_pretty(&r)?);

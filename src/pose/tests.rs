@@ -210,7 +210,7 @@ fn heading_correction_makes_joint_angles_independent_of_facing() {
         for s in &mut out.imus {
             let o = s.orientation[t0];
             for q in &mut s.orientation {
-                *q = *q * o.inverse();
+                *q *= o.inverse();
             }
         }
         out

@@ -50,6 +50,10 @@ pub struct Loaded {
     pub before: Vec<JointFigures>,
     /// Joint angles of the uncorrected trial, filled on demand.
     pub angles: AngleCache,
+    /// The pose calibration `trial` went through (None: as read).
+    pub pose: Option<crate::pose::PoseRecord>,
+    /// The trial as read, while `trial` is pose-calibrated.
+    pub uncalibrated: Option<Arc<Loaded>>,
 }
 
 /// Whether a trial is read yet.
@@ -440,6 +444,13 @@ pub enum Effect {
     /// Ask for `Msg::RecorrectDue` after the debounce delay (a newer request
     /// replaces an older one).
     Debounce,
+    /// Pose-calibrate a loaded trial (answered by `Msg::PoseCalibrated`).
+    PoseCalibrate {
+        file: String,
+        loaded: Arc<Loaded>,
+        calibration: crate::pose::PoseCalibration,
+        limits: LimitTable,
+    },
 }
 
 /// A correction job.
@@ -485,6 +496,8 @@ pub enum Msg {
     /// The limit files on disk differ from what the workbench last loaded or saved.
     LimitsOnDisk(LimitTable, SettingsFile),
     RecorrectDue,
+    /// A pose-calibrated version of a trial, or why there is none.
+    PoseCalibrated(String, Result<Arc<Loaded>, String>),
 }
 
 impl App {
@@ -548,7 +561,7 @@ impl App {
         self.trials.iter().find(|t| t.file == file)
     }
 
-    fn entry_mut(&mut self, file: &str) -> Option<&mut TrialEntry> {
+    pub(super) fn entry_mut(&mut self, file: &str) -> Option<&mut TrialEntry> {
         self.trials.iter_mut().find(|t| t.file == file)
     }
 
@@ -596,11 +609,11 @@ impl App {
         }
     }
 
-    fn info(&mut self, text: impl Into<String>) {
+    pub(super) fn info(&mut self, text: impl Into<String>) {
         self.message = Some((text.into(), false));
     }
 
-    fn error(&mut self, text: impl Into<String>) {
+    pub(super) fn error(&mut self, text: impl Into<String>) {
         self.message = Some((text.into(), true));
     }
 
@@ -612,7 +625,11 @@ impl App {
         l.before.iter().map(|f| f.joint.clone()).collect()
     }
 
-    fn run_effect(&mut self, file: &str, recorrect: Option<Vec<String>>) -> Option<Effect> {
+    pub(super) fn run_effect(
+        &mut self,
+        file: &str,
+        recorrect: Option<Vec<String>>,
+    ) -> Option<Effect> {
         let limits = self.limits.table.clone();
         let limits_source = self.limits.source.clone();
         let settings = self.settings;
@@ -804,6 +821,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
         }
         Msg::RecorrectDue => recorrect_now(app),
+        Msg::PoseCalibrated(file, result) => super::pose::calibrated(app, &file, result),
     }
 }
 
@@ -1112,6 +1130,7 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::End => app.view.cursor_s = d,
         Action::Marker => app.view.braille = !app.view.braille,
         Action::Variant => next_variant(app),
+        Action::Pose => return super::pose::toggle(app),
         Action::Compare => {
             app.compare_col = Variant::ALL
                 .iter()

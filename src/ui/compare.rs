@@ -37,7 +37,16 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         format!("  {}{:>w$}", fit("joint", nw), "raw", w = cw),
         theme.header,
     )];
-    for (k, v) in Variant::ALL.iter().enumerate() {
+    // As many variant columns as fit, scrolled to keep the picked one in view.
+    let fits = (usize::from(area.width).saturating_sub(2 + nw + cw) / cw.max(15)).max(1);
+    let first = app.compare_col.saturating_sub(fits - 1);
+    let shown: Vec<(usize, &Variant)> = Variant::ALL
+        .iter()
+        .enumerate()
+        .skip(first)
+        .take(fits)
+        .collect();
+    for &(k, v) in &shown {
         let mut name = v.name().to_string();
         if e.chosen == Some(*v) {
             name = format!("*{name}");
@@ -82,7 +91,8 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     }
     for (k, (name, cells)) in rows.iter().enumerate() {
         let mut spans = vec![Span::raw(format!("{name}{:>w$}", cells[0], w = cw))];
-        for (c, text) in cells[1..].iter().enumerate() {
+        for &(c, _) in &shown {
+            let text = &cells[1 + c];
             let style = if c == app.compare_col {
                 theme.corrected
             } else {
@@ -104,7 +114,8 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         format!("  {}{:>w$}", fit("mean", nw), mean[0], w = cw),
         theme.header,
     )];
-    for text in &mean[1..] {
+    for &(c, _) in &shown {
+        let text = &mean[1 + c];
         spans.push(Span::styled(
             format!(" {text:>w$}", w = cw.max(15) - 1),
             theme.header,

@@ -88,6 +88,8 @@ pub fn load_trial(file: &str, path: &Path, limits: &LimitTable) -> Msg {
             truth_error,
             before,
             angles: Default::default(),
+            pose: None,
+            uncalibrated: None,
         }))
     })();
     Msg::Loaded(file.to_string(), result)
@@ -164,6 +166,7 @@ pub fn save_variant(
         input: path,
         input_format: loaded.format,
         trial: &loaded.trial,
+        pose: loaded.pose.as_ref(),
         correction,
         model: &loaded.model,
         limits,
@@ -235,6 +238,17 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
             settings_toml,
         } => vec![save_limits(&dir, &table_name, &table_csv, &settings_toml)],
         Effect::Debounce => vec![Msg::RecorrectDue],
+        Effect::PoseCalibrate {
+            file,
+            loaded,
+            calibration,
+            limits,
+        } => vec![super::pose::calibrate_job(
+            &file,
+            &loaded,
+            &calibration,
+            &limits,
+        )],
     }
 }
 

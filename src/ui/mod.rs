@@ -14,6 +14,7 @@ pub mod headless;
 pub mod jobs;
 pub mod keymap;
 pub mod limits;
+pub mod pose;
 pub mod render;
 pub mod runtime;
 pub mod theme;

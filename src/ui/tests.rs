@@ -142,7 +142,7 @@ fn trial_flow_run_compare_save() {
     assert!(app.open_entry().unwrap().results.is_empty());
     keys(&mut app, "r");
     let e = app.open_entry().unwrap();
-    assert_eq!(e.results.len(), 3);
+    assert_eq!(e.results.len(), Variant::ALL.len());
     assert_eq!(e.running, None);
     // Zoom, pan, cursor, variant, joint.
     keys(&mut app, "++");
@@ -189,6 +189,51 @@ fn trial_flow_run_compare_save() {
     assert!(!app.unsaved());
     keys(&mut app, "q");
     assert!(app.quit);
+}
+
+#[test]
+fn pose_calibration_toggles_and_ik_shows() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    shown(&mut app, "trial", "fb.csv.gz");
+    for _ in 0..10 {
+        keys(&mut app, ".");
+    }
+    let cursor = app.view.cursor_s;
+    assert!(cursor > 0.0);
+    keys(&mut app, "P");
+    let e = app.open_entry().unwrap();
+    let l = e.loaded().unwrap();
+    let p = l.pose.as_ref().expect("calibrated");
+    // At the sample under the cursor (50 Hz).
+    let crate::pose::PoseTime::At(at) = p.calibration.at else {
+        panic!("a single instant")
+    };
+    assert!((at - cursor).abs() <= 0.01 && (at * 50.0 - (at * 50.0).round()).abs() < 1e-9);
+    assert!(l.uncalibrated.is_some());
+    // Every variant ran again on the calibrated trial.
+    assert_eq!(e.results.len(), Variant::ALL.len());
+    assert!(e
+        .results
+        .values()
+        .all(|r| r.correction.corrected.imus.len() == 13));
+    while app.variant != Variant::Ik {
+        keys(&mut app, "v");
+    }
+    let e = app.open_entry().unwrap();
+    assert!(e.results[&Variant::Ik].correction.ik.is_some());
+    snap("trial_pose_ik", &app);
+    // P again: back to the trial as read, corrected again.
+    keys(&mut app, "P");
+    let e = app.open_entry().unwrap();
+    assert!(e.loaded().unwrap().pose.is_none());
+    assert_eq!(e.results.len(), Variant::ALL.len());
+    // The knee trial has no base IMU: the calibration says why.
+    shown(&mut app, "trial", "knee.csv");
+    keys(&mut app, "P");
+    let (m, is_error) = app.message.clone().unwrap();
+    assert!(is_error && m.contains("base IMU"), "{m}");
+    assert!(app.open_entry().unwrap().loaded().unwrap().pose.is_none());
 }
 
 fn limits_app(fx: &Fixture) -> App {

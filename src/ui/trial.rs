@@ -216,6 +216,12 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                 app.view.cursor_s
             )),
             Span::styled(status, theme.dim),
+            Span::styled(
+                super::pose::label(l)
+                    .map(|p| format!("  {p}"))
+                    .unwrap_or_default(),
+                theme.header,
+            ),
         ])),
         foot,
     );

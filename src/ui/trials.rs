@@ -24,7 +24,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let details_h = if area.height >= 16 { 5 } else { 0 };
     let [list, details] =
         Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area);
-    let fixed = 2 + 8 + 6 + 5 + 3 * 7 + 7 + 7;
+    let fixed = 2 + 8 + 6 + 5 + Variant::ALL.len() * 7 + 7 + 7;
     let nw = (list.width as usize).saturating_sub(fixed).max(8);
     let filter = if app.filter_editing || !app.filter.is_empty() {
         format!(
@@ -35,21 +35,18 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     } else {
         String::new()
     };
-    let mut lines = vec![Line::from(Span::styled(
-        format!(
-            "  {}{:>8}{:>6}{:>5}{:>7}{:>7}{:>7}{:>7}{:>7}",
-            fit(&format!("trial (sort: {}){filter}", app.sort.name()), nw),
-            "dur s",
-            "Hz",
-            "IMUs",
-            "basic",
-            "drift",
-            "d+c",
-            "exc",
-            app.variant.name().chars().take(6).collect::<String>(),
-        ),
-        theme.header,
-    ))];
+    let mut head = format!(
+        "  {}{:>8}{:>6}{:>5}",
+        fit(&format!("trial (sort: {}){filter}", app.sort.name()), nw),
+        "dur s",
+        "Hz",
+        "IMUs",
+    );
+    for v in Variant::ALL {
+        head.push_str(&format!("{:>7}", short_name(v)));
+    }
+    head.push_str(&format!("{:>7}{:>7}", "exc", short_name(app.variant)));
+    let mut lines = vec![Line::from(Span::styled(head, theme.header))];
     let visible = app.visible();
     let rows = list.height.saturating_sub(1) as usize;
     let first = app.selected.saturating_sub(rows.saturating_sub(1));
@@ -130,5 +127,13 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                 .block(Block::new().borders(Borders::TOP).title(" details ")),
             details,
         );
+    }
+}
+
+/// A variant's name in at most six characters (`d+c` for drift-centroid).
+fn short_name(v: Variant) -> String {
+    match v {
+        Variant::DriftCentroid => "d+c".into(),
+        v => v.name().chars().take(6).collect(),
     }
 }
