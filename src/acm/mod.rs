@@ -40,6 +40,10 @@ pub enum Variant {
     Drift,
     /// Windows + slerp + the centroid term (lambda2 from the table).
     DriftCentroid,
+    /// Rivest (2005) for the knees, per drift window; `drift-centroid` elsewhere.
+    Rivest,
+    /// Mueller et al. (2017) axes for the elbows; `drift-centroid` elsewhere.
+    Mueller,
     /// IMU inverse kinematics (`crate::ik`): joint coordinates with the
     /// model's degrees of freedom and hard limits; not the ACM.
     Ik,
@@ -47,10 +51,12 @@ pub enum Variant {
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 4] = [
+    pub const ALL: [Variant; 6] = [
         Variant::Basic,
         Variant::Drift,
         Variant::DriftCentroid,
+        Variant::Rivest,
+        Variant::Mueller,
         Variant::Ik,
     ];
 
@@ -60,6 +66,8 @@ impl Variant {
             Variant::Basic => "basic",
             Variant::Drift => "drift",
             Variant::DriftCentroid => "drift-centroid",
+            Variant::Rivest => "rivest",
+            Variant::Mueller => "mueller",
             Variant::Ik => "ik",
         }
     }
@@ -71,12 +79,15 @@ impl Variant {
 
     /// Solves per window (true) or once for the whole trial (false).
     pub fn windowed(self) -> bool {
-        matches!(self, Variant::Drift | Variant::DriftCentroid)
+        !matches!(self, Variant::Basic | Variant::Ik)
     }
 
     /// Uses the table's centroid term.
     pub fn centroid(self) -> bool {
-        matches!(self, Variant::DriftCentroid)
+        matches!(
+            self,
+            Variant::DriftCentroid | Variant::Rivest | Variant::Mueller
+        )
     }
 }
 
@@ -120,6 +131,10 @@ pub struct JointResult {
     /// its own joint was skipped).
     pub parent_corrected: bool,
     pub windows: Vec<WindowSolution>,
+    /// What a baseline method found, for the joints a baseline variant
+    /// corrects (`rivest`, `mueller`); absent for ACM joints.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<crate::baselines::BaselineRecord>,
 }
 
 /// A joint the engine did not correct, and why.

@@ -18,6 +18,9 @@ pub struct ReportArgs {
     /// Print JSON instead of text tables.
     #[arg(long)]
     pub json: bool,
+    /// Apply this functional calibration (`acmw calibrate`) to the trial first.
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
     #[command(flatten)]
     pub engine: EngineArgs,
     #[command(flatten)]
@@ -30,9 +33,15 @@ pub struct ReportArgs {
 /// Runs `acmw report`.
 pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     let ctx = load_context(&args.engine, Some(&args.input))?;
-    let trial = read_trial(&args.input, &ctx.model)?;
-    let calibration = args.pose.calibration(&ctx.model);
-    let (trial, pose) = apply_pose(trial, &ctx.model, calibration.as_ref(), &args.input)?;
+    let mut trial = read_trial(&args.input, &ctx.model)?;
+    super::calibrate::apply(
+        args.calibration.as_deref(),
+        &mut trial,
+        &ctx.model,
+        args.quiet,
+    )?;
+    let pose_calibration = args.pose.calibration(&ctx.model);
+    let (trial, pose) = apply_pose(trial, &ctx.model, pose_calibration.as_ref(), &args.input)?;
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {
             let t = t?;

@@ -236,6 +236,32 @@ fn pose_calibration_toggles_and_ik_shows() {
     assert!(app.open_entry().unwrap().loaded().unwrap().pose.is_none());
 }
 
+#[test]
+fn compare_scrolls_to_the_baselines_and_saves_one() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    app.select_file("fb.csv.gz");
+    key(&mut app, KeyCode::Enter);
+    keys(&mut app, "r");
+    keys(&mut app, "c");
+    while Variant::ALL[app.compare_col] != Variant::Mueller {
+        key(&mut app, KeyCode::Right);
+    }
+    key(&mut app, KeyCode::Char(' '));
+    assert_eq!(app.open_entry().unwrap().chosen, Some(Variant::Mueller));
+    // At 80 columns the variants scroll: rivest and mueller are in view.
+    snap("compare_baselines", &app);
+    keys(&mut app, "w");
+    let out = fx.root().join("trials/corrected/fb.mueller.csv.gz");
+    assert!(out.exists(), "{:?}", app.message);
+    let sc = crate::sidecar::Sidecar::load(&crate::sidecar::sidecar_path(&out)).unwrap();
+    assert_eq!(sc.variant, Variant::Mueller);
+    for j in &sc.joints {
+        let is_elbow = j.joint.ends_with("elbow");
+        assert_eq!(j.baseline.is_some(), is_elbow, "{}", j.joint);
+    }
+}
+
 fn limits_app(fx: &Fixture) -> App {
     let mut app = fx.app();
     shown(&mut app, "trial", "knee.csv");
