@@ -10,6 +10,7 @@
 //! - `misaligned`: every non-base IMU 10-30 deg off its segment and 0.5 deg
 //!   noise, no calibration: large residuals, coordinates pressed on the hard
 //!   limits, Gauss-Newton converging linearly (the hard case).
+//!
 //! The ratios are printed once before the timings.
 
 use acm_workbench::acm::RunControl;
