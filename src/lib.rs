@@ -5,12 +5,14 @@
 //! `acmw` binary are thin layers over it.
 
 pub mod acm;
+pub mod analysis;
 pub mod baselines;
 pub mod calibration;
 pub mod ik;
 pub mod limits;
 pub mod metrics;
 pub mod model;
+pub mod plot;
 pub mod pose;
 pub mod report;
 pub mod rotation;
