@@ -12,6 +12,7 @@ pub mod app;
 pub mod calibration;
 pub mod compare;
 pub mod headless;
+pub mod histogram;
 pub mod jobs;
 pub mod keymap;
 pub mod limits;
