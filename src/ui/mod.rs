@@ -10,6 +10,7 @@
 
 pub mod app;
 pub mod compare;
+pub mod glitches;
 pub mod headless;
 pub mod jobs;
 pub mod keymap;
