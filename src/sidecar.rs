@@ -57,6 +57,9 @@ pub struct Sidecar {
     pub skipped: Vec<SkippedJoint>,
     pub figures: FiguresRecord,
     pub warnings: Vec<String>,
+    /// A functional calibration applied to the trial before the correction.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<crate::calibration::AppliedCalibration>,
 }
 
 /// Hex SHA-256 of bytes.
@@ -105,6 +108,7 @@ impl Sidecar {
             skipped: correction.skipped.clone(),
             figures,
             warnings: Vec::new(),
+            calibration: None,
         }
     }
 
@@ -221,11 +225,16 @@ impl SaveRequest<'_> {
     /// Writes the corrected trial and its sidecar, each atomically (previous
     /// files are kept as `.bak`). Returns the sidecar's path.
     pub fn save(&self) -> anyhow::Result<PathBuf> {
+        self.save_with(self.sidecar()?)
+    }
+
+    /// Writes the corrected trial and the given sidecar (built by
+    /// [`SaveRequest::sidecar`], perhaps amended), as [`SaveRequest::save`] does.
+    pub fn save_with(&self, sidecar: Sidecar) -> anyhow::Result<PathBuf> {
         if let Some(dir) = self.output.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| anyhow::anyhow!("{}: cannot create folder: {e}", dir.display()))?;
         }
-        let sidecar = self.sidecar()?;
         write_trial(&self.correction.corrected, self.output, self.output_format)?;
         let path = self
             .sidecar

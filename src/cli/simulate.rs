@@ -33,6 +33,9 @@ pub enum What {
     /// A named configuration (knee_calf_z15, full_body_clean, full_body_drift, elbow_20);
     /// the common options override it.
     Preset(PresetArgs),
+    /// A functional calibration recording (Ricci et al. 2014 protocol) with known
+    /// sensor-to-frame rotations, sloppy movements and noise.
+    Calibration(super::calibrate::SimulateCalibrationArgs),
 }
 
 #[derive(Debug, Args)]
@@ -175,6 +178,7 @@ impl CommonArgs {
 /// Runs `acmw simulate`.
 pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
     let (mut cfg, common) = match args.what {
+        What::Calibration(a) => return super::calibrate::simulate_run(a),
         What::Knee(a) => (SimConfig::knee(a.imu, a.axis, a.angle), a.common),
         What::Elbow(a) => {
             let mut cfg = SimConfig::elbow(0, a.angle);
