@@ -155,6 +155,7 @@ pub enum Screen {
     Trial,
     Compare,
     Limits,
+    Calibration,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -409,6 +410,8 @@ pub struct App {
     /// A message in the status bar: (text, is_error).
     pub message: Option<(String, bool)>,
     pub quit: bool,
+    /// The calibration screen (`super::calibration`).
+    pub calib: super::calibration::CalibState,
 }
 
 /// What the runtime should do.
@@ -439,6 +442,8 @@ pub enum Effect {
         table_csv: String,
         settings_toml: String,
     },
+    /// Read and calibrate the calibration recordings of this folder.
+    Calibrations { dir: PathBuf },
     /// Ask for `Msg::RecorrectDue` after the debounce delay (a newer request
     /// replaces an older one).
     Debounce,
@@ -487,6 +492,8 @@ pub enum Msg {
     /// The limit files on disk differ from what the workbench last loaded or saved.
     LimitsOnDisk(LimitTable, SettingsFile),
     RecorrectDue,
+    /// The calibration recordings of the folder, read and calibrated (protocol label).
+    Calibrations(Vec<super::calibration::CalibEntry>, String),
 }
 
 impl App {
@@ -513,6 +520,7 @@ impl App {
             limits_from: Screen::Trials,
             message: None,
             quit: false,
+            calib: Default::default(),
         };
         for f in files {
             let path = app.dir.join(&f);
@@ -806,6 +814,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
         }
         Msg::RecorrectDue => recorrect_now(app),
+        Msg::Calibrations(entries, protocol) => {
+            super::calibration::loaded(app, entries, protocol);
+            vec![]
+        }
     }
 }
 
@@ -1023,6 +1035,7 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Trial => trial_action(app, a),
         Screen::Compare => compare_action(app, a),
         Screen::Limits => limits_action(app, a),
+        Screen::Calibration => super::calibration::action(app, a),
     }
 }
 
@@ -1044,6 +1057,7 @@ fn trials_action(app: &mut App, a: Action) -> Vec<Effect> {
             app.sort_trials();
         }
         Action::Variant => next_variant(app),
+        Action::Calibration => return super::calibration::enter(app),
         Action::Enter | Action::Right => {
             let Some(e) = app.selected_entry() else {
                 return vec![];

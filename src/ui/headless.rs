@@ -15,7 +15,14 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The screens `acmw render` knows.
-pub const SCREENS: [&str; 5] = ["trials", "trial", "compare", "limits", "help"];
+pub const SCREENS: [&str; 6] = [
+    "trials",
+    "trial",
+    "compare",
+    "limits",
+    "help",
+    "calibration",
+];
 
 /// A workbench over `dir` (shown as `dir_label`) with every trial read.
 pub fn load_app(dir_label: &str, dir: &Path, limits_dir: &Path) -> Result<App, String> {
@@ -99,6 +106,10 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
         }
         "limits" => app.screen = Screen::Limits,
         "help" => app.overlay = Some(Overlay::Help),
+        "calibration" => {
+            let fx = super::calibration::enter(app);
+            SyncRunner::run(app, fx);
+        }
         _ => {}
     }
     Ok(())
@@ -219,5 +230,6 @@ pub fn write_demo_folder(dir: &Path) -> Result<(), String> {
         sim.truth.save_beside(&out).map_err(|e| e.to_string())?;
     }
     std::fs::write(dir.join("broken.csv"), "garbage,1,2\n").map_err(|e| e.to_string())?;
+    super::calibration::write_demo_recordings(dir)?;
     Ok(())
 }

@@ -9,6 +9,7 @@
 //! * [`headless`]: any screen as text (`acmw render`, snapshot tests).
 
 pub mod app;
+pub mod calibration;
 pub mod compare;
 pub mod glitches;
 pub mod headless;

@@ -33,6 +33,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
         Screen::Trial => trial::render(app, theme, f, body),
         Screen::Compare => compare::render(app, theme, f, body),
         Screen::Limits => limits::render(app, theme, f, body),
+        Screen::Calibration => super::calibration::render(app, theme, f, body),
     }
     status_bar(app, theme, f, bottom);
     match &app.overlay {
@@ -49,6 +50,7 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         Screen::Trial => format!("Trial {}", app.open.as_deref().unwrap_or("")),
         Screen::Compare => format!("Compare {}", app.open.as_deref().unwrap_or("")),
         Screen::Limits => "Limits".to_string(),
+        Screen::Calibration => "Calibration".to_string(),
     };
     let mut spans = vec![
         Span::styled(" acmw ", theme.title),
@@ -84,6 +86,7 @@ pub fn hints(app: &App) -> &'static str {
         }
         Screen::Compare => "<- -> variant  Space choose  w save  r run  Esc back  ? help",
         Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
+        Screen::Calibration => "Up/Down recording  r read again  Esc back  ? help  q quit",
     }
 }
 
