@@ -5,11 +5,13 @@
 //! `acmw` binary are thin layers over it.
 
 pub mod acm;
+pub mod analysis;
 pub mod baselines;
 pub mod calibration;
 pub mod limits;
 pub mod metrics;
 pub mod model;
+pub mod plot;
 pub mod report;
 pub mod rotation;
 pub mod save;
