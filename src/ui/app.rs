@@ -156,6 +156,7 @@ pub enum Screen {
     Compare,
     Limits,
     Calibration,
+    Histogram,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -412,6 +413,8 @@ pub struct App {
     pub quit: bool,
     /// The calibration screen (`super::calibration`).
     pub calib: super::calibration::CalibState,
+    /// The histogram screen, once opened.
+    pub histogram: Option<super::histogram::HistogramState>,
 }
 
 /// What the runtime should do.
@@ -444,6 +447,12 @@ pub enum Effect {
     },
     /// Read and calibrate the calibration recordings of this folder.
     Calibrations { dir: PathBuf },
+    /// Write a table (CSV text) atomically, never over `original`.
+    WriteTable {
+        path: PathBuf,
+        original: Option<PathBuf>,
+        csv: String,
+    },
     /// Ask for `Msg::RecorrectDue` after the debounce delay (a newer request
     /// replaces an older one).
     Debounce,
@@ -494,6 +503,8 @@ pub enum Msg {
     RecorrectDue,
     /// The calibration recordings of the folder, read and calibrated (protocol label).
     Calibrations(Vec<super::calibration::CalibEntry>, String),
+    /// A suggested limit table or a centroid table was written (its path), or why not.
+    TableWritten(Result<String, String>),
 }
 
 impl App {
@@ -521,6 +532,7 @@ impl App {
             message: None,
             quit: false,
             calib: Default::default(),
+            histogram: None,
         };
         for f in files {
             let path = app.dir.join(&f);
@@ -818,6 +830,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             super::calibration::loaded(app, entries, protocol);
             vec![]
         }
+        Msg::TableWritten(result) => {
+            super::histogram::written(app, result);
+            vec![]
+        }
     }
 }
 
@@ -1027,6 +1043,10 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
             app.screen = Screen::Limits;
             return vec![];
         }
+        Action::Histogram if matches!(app.screen, Screen::Trials | Screen::Trial) => {
+            app.message = None;
+            return super::histogram::open(app);
+        }
         _ => {}
     }
     app.message = None;
@@ -1036,6 +1056,7 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Compare => compare_action(app, a),
         Screen::Limits => limits_action(app, a),
         Screen::Calibration => super::calibration::action(app, a),
+        Screen::Histogram => super::histogram::action(app, a),
     }
 }
 

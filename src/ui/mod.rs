@@ -13,6 +13,7 @@ pub mod calibration;
 pub mod compare;
 pub mod glitches;
 pub mod headless;
+pub mod histogram;
 pub mod jobs;
 pub mod keymap;
 pub mod limits;

@@ -34,6 +34,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
         Screen::Compare => compare::render(app, theme, f, body),
         Screen::Limits => limits::render(app, theme, f, body),
         Screen::Calibration => super::calibration::render(app, theme, f, body),
+        Screen::Histogram => super::histogram::render(app, theme, f, body),
     }
     status_bar(app, theme, f, bottom);
     match &app.overlay {
@@ -51,6 +52,7 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         Screen::Compare => format!("Compare {}", app.open.as_deref().unwrap_or("")),
         Screen::Limits => "Limits".to_string(),
         Screen::Calibration => "Calibration".to_string(),
+        Screen::Histogram => "Histograms".to_string(),
     };
     let mut spans = vec![
         Span::styled(" acmw ", theme.title),
@@ -87,6 +89,9 @@ pub fn hints(app: &App) -> &'static str {
         Screen::Compare => "<- -> variant  Space choose  w save  r run  Esc back  ? help",
         Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
         Screen::Calibration => "Up/Down recording  r read again  Esc back  ? help  q quit",
+        Screen::Histogram => {
+            "Enter suggest  w centroids  <- -> span  +- length  Home 30 s  End all  Esc back"
+        }
     }
 }
 
