@@ -11,6 +11,7 @@
 pub mod app;
 pub mod calibration;
 pub mod compare;
+pub mod glitches;
 pub mod headless;
 pub mod histogram;
 pub mod jobs;
