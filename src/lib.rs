@@ -5,6 +5,7 @@
 //! `acmw` binary are thin layers over it.
 
 pub mod acm;
+pub mod analysis;
 pub mod limits;
 pub mod metrics;
 pub mod model;
