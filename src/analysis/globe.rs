@@ -15,7 +15,7 @@
 //! it. For other joints (shoulder: Y, elbow: Z) the point is the direction the
 //! segment would have without its rotation angle.
 
-use super::scatter::{Colouring, Raster};
+use super::scatter::{Colouring, Grid, Raster};
 use crate::limits::LimitTable;
 
 /// Which Euler axis (0 = X, 1 = Y, 2 = Z) of a joint is which movement.
@@ -201,11 +201,44 @@ impl GlobeView {
         (dot(d, self.right), dot(d, self.up), dot(d, self.centre))
     }
 
+    /// The screen rectangle `(x, y)` bounds holding the visible parts of the
+    /// `outlines` (each the boundary of a region within the visible
+    /// hemisphere, so its image bounds the region's), padded by `pad` times
+    /// the larger side, within the disc's square `[-1.05, 1.05]`.
+    pub fn fit(&self, outlines: &[Vec<[f64; 3]>], pad: f64) -> ([f64; 2], [f64; 2]) {
+        let mut b = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+        for p in outlines.iter().flatten().filter_map(|d| self.visible(*d)) {
+            b[0] = [b[0][0].min(p.0), b[0][1].max(p.0)];
+            b[1] = [b[1][0].min(p.1), b[1][1].max(p.1)];
+        }
+        let r = 1.05;
+        if !b[0][0].is_finite() {
+            return ([-r, r], [-r, r]);
+        }
+        let m = pad * (b[0][1] - b[0][0]).max(b[1][1] - b[1][0]).max(0.05);
+        let c = |v: [f64; 2]| [(v[0] - m).max(-r), (v[1] + m).min(r)];
+        (c(b[0]), c(b[1]))
+    }
+
     /// Screen coordinates of a direction on the visible hemisphere.
     pub fn visible(&self, d: [f64; 3]) -> Option<(f64, f64)> {
         let (x, y, z) = self.project(d);
         (z >= 0.0).then_some((x, y))
     }
+}
+
+/// The flexion and ab/adduction extents of samples, `[[flex lo, hi], [abd lo,
+/// hi]]` in degrees (None without finite samples).
+pub fn extent(angles: &[[f64; 3]], axes: JointAxes) -> Option<[[f64; 2]; 2]> {
+    let mut e = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+    for a in angles {
+        for (k, ax) in [axes.flexion, axes.abduction].into_iter().enumerate() {
+            if a[ax].is_finite() {
+                e[k] = [e[k][0].min(a[ax]), e[k][1].max(a[ax])];
+            }
+        }
+    }
+    e[0][0].is_finite().then_some(e)
 }
 
 /// Whether flexion and ab/adduction are inside their limits (the band).
@@ -236,8 +269,24 @@ pub fn band_points(range_deg: &[[f64; 2]; 3], axes: JointAxes, step_deg: f64) ->
 /// The outline of the band: its four edges, `per_edge` points each, in order
 /// around it (a closed polygon on the sphere).
 pub fn band_outline(range_deg: &[[f64; 2]; 3], axes: JointAxes, per_edge: usize) -> Vec<[f64; 3]> {
-    let [f0, f1] = range_deg[axes.flexion];
-    let [a0, a1] = range_deg[axes.abduction];
+    rect_outline(
+        range_deg[axes.flexion],
+        range_deg[axes.abduction],
+        axes,
+        per_edge,
+    )
+}
+
+/// The outline of the region of flexion in `flex` and ab/adduction in `abd`
+/// (degrees), `per_edge` points per edge, in order around it.
+pub fn rect_outline(
+    flex: [f64; 2],
+    abd: [f64; 2],
+    axes: JointAxes,
+    per_edge: usize,
+) -> Vec<[f64; 3]> {
+    let [f0, f1] = flex;
+    let [a0, a1] = abd;
     let n = per_edge.max(2);
     let lerp = |a: f64, b: f64, i: usize| a + (b - a) * i as f64 / (n - 1) as f64;
     let mut out = Vec::with_capacity(4 * n);
@@ -278,7 +327,7 @@ pub fn grid_lines(axes: JointAxes, every_deg: f64, per_line: usize) -> Vec<Vec<[
 pub const GLOBE_BIN_DEG: f64 = 0.25;
 
 /// The samples' directions on the visible hemisphere of `view`, reduced to a
-/// raster of `w` x `h` dots over `[-1, 1]` x `[-1, 1]` (keys by `colouring`).
+/// raster of `grid` in screen coordinates (keys by `colouring`).
 ///
 /// The direction depends only on flexion and ab/adduction, so samples are
 /// first binned by those two angles ([`GLOBE_BIN_DEG`]), keeping the highest
@@ -291,10 +340,9 @@ pub fn globe_raster(
     axes: JointAxes,
     view: &GlobeView,
     colouring: Colouring,
-    w: usize,
-    h: usize,
+    grid: Grid,
 ) -> Raster {
-    let mut out = Raster::new(w, h);
+    let mut out = Raster::new(grid.w, grid.h);
     let n = angles.len();
     if n == 0 {
         return out;
@@ -329,7 +377,6 @@ pub fn globe_raster(
         let cell = &mut bins[bf * na + ba];
         *cell = (*cell).max(colouring.key(i, n, *a, range_deg) + 1);
     }
-    let b = [-1.0, 1.0];
     for (k, &key) in bins.iter().enumerate() {
         if key == 0 {
             continue;
@@ -337,7 +384,7 @@ pub fn globe_raster(
         let f = f0 + ((k / na) as f64 + 0.5) * GLOBE_BIN_DEG;
         let a = a0 + ((k % na) as f64 + 0.5) * GLOBE_BIN_DEG;
         if let Some((x, y)) = view.visible(direction_at(f, a, axes)) {
-            out.plot(x, y, b, b, key - 1);
+            out.plot(x, y, grid.bx, grid.by, key - 1);
         }
     }
     out
@@ -346,7 +393,7 @@ pub fn globe_raster(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::scatter::{classify, LimitClass};
+    use crate::analysis::scatter::{classify, Grid, LimitClass};
     use crate::rotation::{euler_zyx_deg, quat_from_euler_zyx_deg, quat_from_wxyz, Quat};
     use nalgebra::Vector3;
 
@@ -498,6 +545,9 @@ mod tests {
             assert!(y_up > 0.03);
             let (x_r, _, _) = v.project(direction_at(fm, am + 10.0, axes));
             assert!(x_r > 0.03);
+            // Fitting the band: it fills the rectangle, inside the disc.
+            let (bx, by) = v.fit(&[band_outline(&range, axes, 20)], 0.0);
+            assert!(bx[0] >= -1.05 && bx[1] <= 1.05 && by[0] < 0.0 && by[1] > 0.0);
             // Orthonormal screen basis.
             assert!(dot(v.right, v.up).abs() < 1e-9 && dot(v.right, v.centre).abs() < 1e-9);
         }
@@ -509,7 +559,13 @@ mod tests {
         let view = GlobeView::for_limits(&KNEE, axes);
         // Three samples: inside, near, beyond; on distinct dots.
         let angles = [[0.0, 65.0, 0.0], [8.0, 40.0, 0.0], [0.0, 90.0, 30.0]];
-        let r = globe_raster(&angles, &KNEE, axes, &view, Colouring::Limits, 400, 400);
+        let grid = |n| Grid {
+            w: n,
+            h: n,
+            bx: [-1.0, 1.0],
+            by: [-1.0, 1.0],
+        };
+        let r = globe_raster(&angles, &KNEE, axes, &view, Colouring::Limits, grid(400));
         assert_eq!(r.count(), 3);
         for a in angles {
             let (x, y) = view.visible(direction(a, axes)).unwrap();
@@ -524,7 +580,7 @@ mod tests {
         // The far side of the sphere is not drawn.
         let back = [[0.0, -100.0, 0.0]];
         assert_eq!(
-            globe_raster(&back, &KNEE, axes, &view, Colouring::Limits, 50, 50).count(),
+            globe_raster(&back, &KNEE, axes, &view, Colouring::Limits, grid(50)).count(),
             0
         );
     }

@@ -38,7 +38,7 @@ impl LimitClass {
         match self {
             LimitClass::Within => "within",
             LimitClass::Near => "<=10 deg out",
-            LimitClass::Beyond => ">10 deg out",
+            LimitClass::Beyond => ">10 out",
         }
     }
 
@@ -128,6 +128,17 @@ pub fn time_bin(i: usize, n: usize) -> u8 {
 /// The three projections of the scatter: (horizontal, vertical) axis indices
 /// into `[x, y, z]`: X-Y, X-Z and Y-Z.
 pub const PROJECTIONS: [(usize, usize); 3] = [(0, 1), (0, 2), (1, 2)];
+
+/// A raster's size in dots and the rectangle of coordinates it covers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    pub w: usize,
+    pub h: usize,
+    /// Horizontal bounds `[left, right]`.
+    pub bx: [f64; 2],
+    /// Vertical bounds `[bottom, top]`.
+    pub by: [f64; 2],
+}
 
 /// A grid of `w` x `h` dots, row 0 at the top; each dot holds the highest key
 /// plotted into it. Points map to the nearest dot as ratatui's canvas maps
@@ -266,10 +277,12 @@ mod tests {
                 worst = worst.max(r[k][0] - a[k]);
             }
         }
-        match worst {
-            w if w == 0.0 => LimitClass::Within,
-            w if w <= 10.0 => LimitClass::Near,
-            _ => LimitClass::Beyond,
+        if worst == 0.0 {
+            LimitClass::Within
+        } else if worst <= 10.0 {
+            LimitClass::Near
+        } else {
+            LimitClass::Beyond
         }
     }
 

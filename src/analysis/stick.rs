@@ -91,13 +91,19 @@ impl Skeleton {
     }
 
     /// The segments for the given IMU orientations (`G_R_imu`); a segment whose
-    /// IMU, or whose parent, has none is `None`.
+    /// IMU, or whose parent, has none is `None`, except that the first segment
+    /// placed starts at the origin whether its parent is placed or not.
     pub fn pose(&self, orientation: impl Fn(&str) -> Option<Quat>) -> Vec<Option<Segment>> {
         let mut out: Vec<Option<Segment>> = Vec::with_capacity(self.bones.len());
         for b in &self.bones {
+            // A segment whose parent is not placed starts at the origin when
+            // nothing is placed yet (a trial without its base IMU, say).
+            let first = out.iter().all(Option::is_none);
             let start = match b.parent {
                 None => Some([0.0; 3]),
-                Some(p) => out[p].map(|s| if b.at_parent_end { s[1] } else { s[0] }),
+                Some(p) => out[p]
+                    .map(|s| if b.at_parent_end { s[1] } else { s[0] })
+                    .or(first.then_some([0.0; 3])),
             };
             let seg = start.zip(orientation(&b.imu)).map(|(s, q)| {
                 let v = q * Vector3::from(b.direction) * b.length_m;
@@ -134,13 +140,13 @@ pub struct BodyFrame {
 }
 
 impl BodyFrame {
-    /// The frame of a pose (its first segment is the base).
+    /// The frame of a pose, from its first placed segment (the base when present).
     pub fn of(pose: &[Option<Segment>]) -> BodyFrame {
         let f = pose
-            .first()
-            .copied()
+            .iter()
             .flatten()
-            .and_then(|[s, e]| unit([e[0] - s[0], e[1] - s[1], 0.0]))
+            .next()
+            .and_then(|&[s, e]| unit([e[0] - s[0], e[1] - s[1], 0.0]))
             .unwrap_or([1.0, 0.0, 0.0]);
         BodyFrame {
             forward: f,
@@ -209,6 +215,13 @@ mod tests {
         assert!(close(pose[idx("l_calf")].unwrap()[1], [0.0, 0.0, 0.26]));
         // Missing IMUs drop their segment and everything below it.
         assert!(pose[idx("l_foot")].is_none() && pose[idx("head")].is_none());
+        // Without the base, the first segment present starts at the origin.
+        let q: HashMap<&str, Quat> =
+            [("l_thigh", Quat::identity()), ("l_calf", Quat::identity())].into();
+        let pose = s.pose(|imu| q.get(imu).copied());
+        assert!(close(pose[idx("l_thigh")].unwrap()[0], [0.0; 3]));
+        assert!(close(pose[idx("l_calf")].unwrap()[1], [-0.26, 0.0, 0.0]));
+        assert_eq!(pose.iter().filter(|p| p.is_some()).count(), 2);
         // The body frame turns with the base: forward is +Y.
         let f = BodyFrame::of(&pose);
         assert!(close(f.forward, [0.0, 1.0, 0.0]) && close(f.left, [-1.0, 0.0, 0.0]));

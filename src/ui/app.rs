@@ -153,6 +153,8 @@ pub enum Screen {
     Trial,
     Compare,
     Limits,
+    /// The analysis views (`super::views`).
+    Views,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -407,6 +409,8 @@ pub struct App {
     /// A message in the status bar: (text, is_error).
     pub message: Option<(String, bool)>,
     pub quit: bool,
+    /// State of the analysis views.
+    pub views: super::views::ViewsState,
 }
 
 /// What the runtime should do.
@@ -485,6 +489,8 @@ pub enum Msg {
     /// The limit files on disk differ from what the workbench last loaded or saved.
     LimitsOnDisk(LimitTable, SettingsFile),
     RecorrectDue,
+    /// Time passes (only sent while something plays).
+    Tick,
 }
 
 impl App {
@@ -511,6 +517,7 @@ impl App {
             limits_from: Screen::Trials,
             message: None,
             quit: false,
+            views: Default::default(),
         };
         for f in files {
             let path = app.dir.join(&f);
@@ -804,6 +811,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
         }
         Msg::RecorrectDue => recorrect_now(app),
+        Msg::Tick => {
+            super::views::tick(app);
+            vec![]
+        }
     }
 }
 
@@ -1021,6 +1032,10 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Trial => trial_action(app, a),
         Screen::Compare => compare_action(app, a),
         Screen::Limits => limits_action(app, a),
+        Screen::Views => {
+            super::views::action(app, a);
+            vec![]
+        }
     }
 }
 
@@ -1082,7 +1097,7 @@ pub fn open(app: &mut App, file: String) {
     app.screen = Screen::Trial;
 }
 
-fn next_variant(app: &mut App) {
+pub(super) fn next_variant(app: &mut App) {
     let k = Variant::ALL
         .iter()
         .position(|v| *v == app.variant)
@@ -1112,6 +1127,10 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::End => app.view.cursor_s = d,
         Action::Marker => app.view.braille = !app.view.braille,
         Action::Variant => next_variant(app),
+        Action::Scatter => super::views::open(app, super::views::ViewKind::Scatter),
+        Action::Globe => super::views::open(app, super::views::ViewKind::Globe),
+        Action::Applied => super::views::open(app, super::views::ViewKind::Applied),
+        Action::Stick => super::views::open(app, super::views::ViewKind::Stick),
         Action::Compare => {
             app.compare_col = Variant::ALL
                 .iter()

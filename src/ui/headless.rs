@@ -15,7 +15,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The screens `acmw render` knows.
-pub const SCREENS: [&str; 5] = ["trials", "trial", "compare", "limits", "help"];
+pub const SCREENS: [&str; 9] = [
+    "trials", "trial", "compare", "limits", "help", "scatter", "globe", "applied", "stick",
+];
 
 /// A workbench over `dir` (shown as `dir_label`) with every trial read.
 pub fn load_app(dir_label: &str, dir: &Path, limits_dir: &Path) -> Result<App, String> {
@@ -57,7 +59,7 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
                 super::app::LoadState::Failed(m) => Some(m.clone()),
                 _ => None,
             } {
-                if matches!(s.screen.as_str(), "trial" | "compare") {
+                if !matches!(s.screen.as_str(), "trials" | "limits" | "help") {
                     return Err(m);
                 }
             }
@@ -73,7 +75,7 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
         app.select_file(t);
     }
     match s.screen.as_str() {
-        "trial" | "compare" => {
+        "trial" | "compare" | "scatter" | "globe" | "applied" | "stick" => {
             let t = trial.ok_or("no trial could be read")?;
             open(app, t.clone());
             if let Some(j) = &s.joint {
@@ -95,6 +97,9 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
             app.message = None;
             if s.screen == "compare" {
                 app.screen = Screen::Compare;
+            }
+            if let Some(kind) = super::views::ViewKind::from_name(&s.screen) {
+                super::views::open(app, kind);
             }
         }
         "limits" => app.screen = Screen::Limits,
