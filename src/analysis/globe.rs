@@ -85,10 +85,15 @@ impl JointAxes {
 pub fn direction(angles_deg: [f64; 3], axes: JointAxes) -> [f64; 3] {
     let mut a = angles_deg;
     a[axes.rotation] = 0.0;
-    let (sx, cx) = a[0].to_radians().sin_cos();
-    let (sy, cy) = a[1].to_radians().sin_cos();
-    let (sz, cz) = a[2].to_radians().sin_cos();
-    match axes.rotation {
+    let sc = a.map(|v| v.to_radians().sin_cos());
+    direction_sc(sc, axes.rotation)
+}
+
+/// [`direction`] from the sines and cosines `(s, c)` of the three angles
+/// (the rotation angle's must be `(0, 1)`).
+fn direction_sc(sc: [(f64, f64); 3], rotation: usize) -> [f64; 3] {
+    let [(sx, cx), (sy, cy), (sz, cz)] = sc;
+    match rotation {
         0 => [cz * cy, sz * cy, -sy],
         1 => [cz * sy * sx - sz * cx, sz * sy * sx + cz * cx, cy * sx],
         _ => [cz * sy * cx + sz * sx, sz * sy * cx - cz * sx, cy * cx],
@@ -322,6 +327,68 @@ pub fn grid_lines(axes: JointAxes, every_deg: f64, per_line: usize) -> Vec<Vec<[
     lines
 }
 
+/// The band of the flexion and ab/adduction limits filled on a raster of
+/// `grid` (screen coordinates of `view`, key 0).
+///
+/// When the whole band lies on the visible hemisphere its projected outline
+/// is a simple closed curve (the orthographic projection is one-to-one
+/// there), so the band is filled row by row between the outline's crossings;
+/// otherwise the band is sampled on a grid of angles finer than a dot.
+pub fn band_raster(
+    range_deg: &[[f64; 2]; 3],
+    axes: JointAxes,
+    view: &GlobeView,
+    grid: Grid,
+) -> Raster {
+    let mut out = Raster::new(grid.w, grid.h);
+    if grid.w < 2 || grid.h < 2 {
+        return out;
+    }
+    let outline = band_outline(range_deg, axes, 96);
+    let poly: Option<Vec<(f64, f64)>> = outline.iter().map(|d| view.visible(*d)).collect();
+    let m = out.mapper(grid.bx, grid.by);
+    let Some(poly) = poly else {
+        // About 0.7 dot apart at the centre of the sphere (closer elsewhere).
+        let step = (0.7 * (grid.bx[1] - grid.bx[0]) / (grid.w - 1) as f64)
+            .to_degrees()
+            .max(0.05);
+        for d in band_points(range_deg, axes, step) {
+            if let Some((x, y)) = view.visible(d) {
+                out.plot_mapped(&m, x, y, 0);
+            }
+        }
+        return out;
+    };
+    let (bx, by) = (grid.bx, grid.by);
+    let col = |x: f64| ((x - bx[0]) / (bx[1] - bx[0]) * (grid.w - 1) as f64).round();
+    let mut xs: Vec<f64> = vec![];
+    for row in 0..grid.h {
+        let y = by[1] - (by[1] - by[0]) * row as f64 / (grid.h - 1) as f64;
+        xs.clear();
+        for k in 0..poly.len() {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            if (a.1 <= y) != (b.1 <= y) {
+                xs.push(a.0 + (y - a.1) / (b.1 - a.1) * (b.0 - a.0));
+            }
+        }
+        xs.sort_by(f64::total_cmp);
+        for pair in xs.chunks_exact(2) {
+            let c0 = col(pair[0]).max(0.0);
+            let c1 = col(pair[1]).min((grid.w - 1) as f64);
+            let mut c = c0;
+            while c <= c1 {
+                out.put(c as usize, row, 0);
+                c += 1.0;
+            }
+        }
+    }
+    // The outline itself, so that a band thinner than a dot row still shows.
+    for p in &poly {
+        out.plot_mapped(&m, p.0, p.1, 0);
+    }
+    out
+}
+
 /// Bin size of [`globe_raster`]'s reduction in angle space, degrees: a quarter
 /// of a dot at 200 dots across the sphere.
 pub const GLOBE_BIN_DEG: f64 = 0.25;
@@ -368,23 +435,34 @@ pub fn globe_raster(
     let nf = ((f1 - f0) / GLOBE_BIN_DEG) as usize + 1;
     let na = ((a1 - a0) / GLOBE_BIN_DEG) as usize + 1;
     let mut bins = vec![0u8; nf * na];
+    let inv = 1.0 / GLOBE_BIN_DEG;
     for (i, a) in angles.iter().enumerate() {
         if !(a[fk].is_finite() && a[ak].is_finite()) {
             continue;
         }
-        let bf = (((a[fk] - f0) / GLOBE_BIN_DEG) as usize).min(nf - 1);
-        let ba = (((a[ak] - a0) / GLOBE_BIN_DEG) as usize).min(na - 1);
+        let bf = (((a[fk] - f0) * inv) as usize).min(nf - 1);
+        let ba = (((a[ak] - a0) * inv) as usize).min(na - 1);
         let cell = &mut bins[bf * na + ba];
         *cell = (*cell).max(colouring.key(i, n, *a, range_deg) + 1);
     }
+    // Bin centres on a grid: their sines and cosines once per row and column.
+    let centre_sc = |lo: f64, k: usize| {
+        (lo + (k as f64 + 0.5) * GLOBE_BIN_DEG)
+            .to_radians()
+            .sin_cos()
+    };
+    let rows: Vec<(f64, f64)> = (0..nf).map(|k| centre_sc(f0, k)).collect();
+    let cols: Vec<(f64, f64)> = (0..na).map(|k| centre_sc(a0, k)).collect();
+    let m = out.mapper(grid.bx, grid.by);
     for (k, &key) in bins.iter().enumerate() {
         if key == 0 {
             continue;
         }
-        let f = f0 + ((k / na) as f64 + 0.5) * GLOBE_BIN_DEG;
-        let a = a0 + ((k % na) as f64 + 0.5) * GLOBE_BIN_DEG;
-        if let Some((x, y)) = view.visible(direction_at(f, a, axes)) {
-            out.plot(x, y, grid.bx, grid.by, key - 1);
+        let mut sc = [(0.0, 1.0); 3];
+        sc[fk] = rows[k / na];
+        sc[ak] = cols[k % na];
+        if let Some((x, y)) = view.visible(direction_sc(sc, axes.rotation)) {
+            out.plot_mapped(&m, x, y, key - 1);
         }
     }
     out
@@ -550,6 +628,47 @@ mod tests {
             assert!(bx[0] >= -1.05 && bx[1] <= 1.05 && by[0] < 0.0 && by[1] > 0.0);
             // Orthonormal screen basis.
             assert!(dot(v.right, v.up).abs() < 1e-9 && dot(v.right, v.centre).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn band_fill_matches_dense_sampling() {
+        let grid = Grid {
+            w: 160,
+            h: 160,
+            bx: [-1.0, 1.0],
+            by: [-1.0, 1.0],
+        };
+        let near = |r: &Raster, c: usize, row: usize| {
+            (c.saturating_sub(1)..=c + 1)
+                .any(|cc| (row.saturating_sub(1)..=row + 1).any(|rr| r.get(cc, rr).is_some()))
+        };
+        for (range, axes) in [
+            (KNEE, JointAxes::default()),
+            (
+                SHOULDER,
+                JointAxes {
+                    rotation: 1,
+                    flexion: 0,
+                    abduction: 2,
+                },
+            ),
+        ] {
+            let view = GlobeView::for_limits(&range, axes);
+            let fill = band_raster(&range, axes, &view, grid);
+            // Every densely sampled band direction lands on (or next to) a
+            // filled dot, and every filled dot is next to a sampled one.
+            let mut dense = Raster::new(grid.w, grid.h);
+            for d in band_points(&range, axes, 0.2) {
+                let (x, y) = view.visible(d).unwrap();
+                dense.plot(x, y, grid.bx, grid.by, 0);
+                let (c, r) = dense.dot(x, y, grid.bx, grid.by).unwrap();
+                assert!(near(&fill, c, r), "{range:?} {c} {r}");
+            }
+            for (c, r, _) in fill.dots() {
+                assert!(near(&dense, c, r), "{range:?} {c} {r}");
+            }
+            assert!(fill.count() > 100);
         }
     }
 

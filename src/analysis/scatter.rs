@@ -179,8 +179,33 @@ impl Raster {
     /// Plots `key` at `(x, y)` (ignored outside the bounds).
     pub fn plot(&mut self, x: f64, y: f64, bx: [f64; 2], by: [f64; 2], key: u8) {
         if let Some((c, r)) = self.dot(x, y, bx, by) {
-            let cell = &mut self.cells[r * self.w + c];
-            *cell = (*cell).max(key + 1);
+            self.put(c, r, key);
+        }
+    }
+
+    /// Keeps `key` at a dot if it is higher than the one there.
+    pub fn put(&mut self, col: usize, row: usize, key: u8) {
+        let cell = &mut self.cells[row * self.w + col];
+        *cell = (*cell).max(key + 1);
+    }
+
+    /// A precomputed [`Raster::dot`] for many points in the same bounds.
+    pub fn mapper(&self, bx: [f64; 2], by: [f64; 2]) -> Mapper {
+        let (sw, sh) = (bx[1] - bx[0], by[1] - by[0]);
+        let ok = self.w > 0 && self.h > 0 && sw > 0.0 && sh > 0.0;
+        Mapper {
+            bx,
+            by,
+            kx: if ok { (self.w - 1) as f64 / sw } else { 0.0 },
+            ky: if ok { (self.h - 1) as f64 / sh } else { 0.0 },
+            ok,
+        }
+    }
+
+    /// Plots `key` at `(x, y)` through a mapper of this raster.
+    pub fn plot_mapped(&mut self, m: &Mapper, x: f64, y: f64, key: u8) {
+        if let Some((c, r)) = m.dot(x, y) {
+            self.put(c.min(self.w - 1), r.min(self.h - 1), key);
         }
     }
 
@@ -211,6 +236,32 @@ impl Raster {
         let fx = col as f64 / (self.w.max(2) - 1) as f64;
         let fy = row as f64 / (self.h.max(2) - 1) as f64;
         (bx[0] + fx * (bx[1] - bx[0]), by[1] - fy * (by[1] - by[0]))
+    }
+}
+
+/// The dot of a point in fixed bounds, with the divisions done once. Rounds
+/// half-way points up as [`Raster::dot`] does (the coordinates are never
+/// negative here).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mapper {
+    bx: [f64; 2],
+    by: [f64; 2],
+    kx: f64,
+    ky: f64,
+    ok: bool,
+}
+
+impl Mapper {
+    /// `(col, row)` of a point inside the bounds.
+    #[inline]
+    pub fn dot(&self, x: f64, y: f64) -> Option<(usize, usize)> {
+        if !(self.ok && x >= self.bx[0] && x <= self.bx[1] && y >= self.by[0] && y <= self.by[1]) {
+            return None;
+        }
+        Some((
+            ((x - self.bx[0]) * self.kx + 0.5) as usize,
+            ((self.by[1] - y) * self.ky + 0.5) as usize,
+        ))
     }
 }
 
@@ -249,11 +300,13 @@ pub fn scatter_rasters(
     h: usize,
 ) -> [Raster; 3] {
     let mut out = [Raster::new(w, h), Raster::new(w, h), Raster::new(w, h)];
+    let maps: [Mapper; 3] =
+        std::array::from_fn(|p| out[p].mapper(bounds[PROJECTIONS[p].0], bounds[PROJECTIONS[p].1]));
     let n = angles.len();
     for (i, a) in angles.iter().enumerate() {
         let key = colouring.key(i, n, *a, range_deg);
-        for (r, &(hx, vy)) in out.iter_mut().zip(PROJECTIONS.iter()) {
-            r.plot(a[hx], a[vy], bounds[hx], bounds[vy], key);
+        for ((r, m), &(hx, vy)) in out.iter_mut().zip(&maps).zip(PROJECTIONS.iter()) {
+            r.plot_mapped(m, a[hx], a[vy], key);
         }
     }
     out
@@ -338,6 +391,13 @@ mod tests {
         assert_eq!(r.get(0, 0), Some(0));
         assert_eq!(r.get(10, 4), Some(1));
         assert_eq!(r.centre(10, 4, bx, by), (10.0, 0.0));
+        // The mapper agrees with `dot` everywhere inside.
+        let m = r.mapper(bx, by);
+        for k in 0..=400 {
+            let (x, y) = (k as f64 * 0.025, (k % 17) as f64 * 0.25);
+            assert_eq!(m.dot(x, y), r.dot(x, y, bx, by), "{x} {y}");
+        }
+        assert_eq!(m.dot(-0.1, 1.0), None);
         let dots: Vec<_> = r.dots().collect();
         assert_eq!(dots, [(0, 0, 0), (3, 3, 2), (10, 4, 1)]);
     }

@@ -12,8 +12,7 @@ use super::views::{
     TIME_COLOURS,
 };
 use crate::analysis::globe::{
-    band_outline, direction_at, extent, globe_raster, grid_lines, rect_outline, GlobeView,
-    JointAxes,
+    band_outline, band_raster, extent, globe_raster, grid_lines, rect_outline, GlobeView, JointAxes,
 };
 use crate::analysis::scatter::{Colouring, Grid};
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -53,29 +52,6 @@ fn draw_runs(ctx: &mut Context, runs: &[Vec<(f64, f64)>], color: Color) {
     }
 }
 
-/// The band as lines of constant ab/adduction, spaced `step_deg` (about a dot)
-/// apart, so that they fill it; each line sampled every 2 degrees of flexion.
-fn band_runs(
-    view: &GlobeView,
-    range: &[[f64; 2]; 3],
-    axes: JointAxes,
-    step_deg: f64,
-) -> Vec<Vec<(f64, f64)>> {
-    let [f0, f1] = range[axes.flexion];
-    let [a0, a1] = range[axes.abduction];
-    let na = ((a1 - a0) / step_deg).ceil().max(1.0) as usize;
-    let nf = ((f1 - f0) / 2.0).ceil().max(1.0) as usize;
-    let mut out = vec![];
-    for j in 0..=na {
-        let a = a0 + (a1 - a0) * j as f64 / na as f64;
-        let line: Vec<[f64; 3]> = (0..=nf)
-            .map(|i| direction_at(f0 + (f1 - f0) * i as f64 / nf as f64, a, axes))
-            .collect();
-        out.extend(visible_runs(view, &line));
-    }
-    out
-}
-
 pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(d) = joint_data(app, e) else {
         f.render_widget(
@@ -110,11 +86,8 @@ pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
     let (fx, fy) = view.fit(&outlines, 0.06);
     let (bx, by) = square_around(left, mk, true, fx, fy);
     let (w, h) = resolution(left, mk, true);
-    // About one dot, in degrees of arc at the centre of the sphere.
-    let dot_deg = ((bx[1] - bx[0]) / w.max(1) as f64)
-        .to_degrees()
-        .clamp(0.25, 2.0);
-    let band = band_runs(&view, &range, axes, dot_deg);
+    let dots = Grid { w, h, bx, by };
+    let band = band_raster(&range, axes, &view, dots);
     // Grid lines every 30, 10 or 5 degrees as the view zooms in.
     let span = (bx[1] - bx[0]).max(by[1] - by[0]);
     let every = if span > 1.2 {
@@ -153,7 +126,6 @@ pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
         (left, Some(&d.raw), "raw".to_string()),
         (right, d.cor.as_ref(), app.variant.to_string()),
     ] {
-        let dots = Grid { w, h, bx, by };
         let raster = angles.map(|a| globe_raster(a, &range, axes, &view, c, dots));
         let title = format!(" {label}: {} around {} ", d.joint.distal, d.joint.name);
         let canvas = Canvas::default()
@@ -175,7 +147,10 @@ pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
                 });
                 draw_runs(ctx, &grid, dim);
                 ctx.layer();
-                draw_runs(ctx, &band, band_colour);
+                ctx.draw(&RasterShape {
+                    raster: &band,
+                    colours: &[band_colour],
+                });
                 ctx.layer();
                 if let Some(r) = &raster {
                     ctx.draw(&RasterShape {
