@@ -5,6 +5,6 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 acmw=${ACMW:-../target/release/acmw}
-for preset in knee_calf_z15 full_body_clean full_body_drift; do
+for preset in knee_calf_z15 full_body_clean full_body_drift elbow_20; do
   "$acmw" simulate preset "$preset" --decimals 6 --truth-json-only -o "$preset.csv.gz"
 done

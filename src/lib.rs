@@ -1,11 +1,13 @@
 //! acm-workbench: the Anatomical Constraint Method for IMU joint angles.
 //!
-//! The numerical core (`rotation`, `model`, `limits`, `trial`, `acm`, `metrics`,
+//! The numerical core (`rotation`, `model`, `limits`, `trial`, `acm`, `calibration`, `metrics`,
 //! `sidecar`, `simulate`, `truth`) knows nothing of the terminal; `ui` and the
 //! `acmw` binary are thin layers over it.
 
 pub mod acm;
 pub mod analysis;
+pub mod baselines;
+pub mod calibration;
 pub mod limits;
 pub mod metrics;
 pub mod model;

@@ -12,6 +12,11 @@ use std::path::Path;
 pub const BUILTIN_MODELS: &[(&str, &str)] = &[
     ("infant13", include_str!("../models/infant13.toml")),
     ("opensim", include_str!("../models/opensim.toml")),
+    (
+        "opensense_lower",
+        include_str!("../models/opensense_lower.toml"),
+    ),
+    ("full_body16", include_str!("../models/full_body16.toml")),
 ];
 
 /// One joint: the rotation of the distal IMU relative to the proximal one.
@@ -67,12 +72,14 @@ pub enum ModelError {
     Parse { path: String, message: String },
     #[error("{path}: {message}")]
     Invalid { path: String, message: String },
-    #[error("unknown built-in model '{0}' (known: infant13, opensim)")]
+    #[error(
+        "unknown built-in model '{0}' (known: infant13, opensim, opensense_lower, full_body16)"
+    )]
     Unknown(String),
 }
 
 impl Model {
-    /// A built-in model by name (`infant13` or `opensim`).
+    /// A built-in model by name (see [`BUILTIN_MODELS`]).
     pub fn builtin(name: &str) -> Result<Model, ModelError> {
         let text = BUILTIN_MODELS
             .iter()

@@ -57,6 +57,9 @@ pub struct Sidecar {
     pub skipped: Vec<SkippedJoint>,
     pub figures: FiguresRecord,
     pub warnings: Vec<String>,
+    /// A functional calibration applied to the trial before the correction.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<crate::calibration::AppliedCalibration>,
 }
 
 /// Hex SHA-256 of bytes.
@@ -105,6 +108,7 @@ impl Sidecar {
             skipped: correction.skipped.clone(),
             figures,
             warnings: Vec::new(),
+            calibration: None,
         }
     }
 
@@ -145,7 +149,7 @@ pub fn default_output(input: &Path, variant: Variant, format: TrialFormat, gzip:
     let name = input.file_name().unwrap_or_default().to_string_lossy();
     let lower = name.to_ascii_lowercase();
     let mut stem_len = name.len();
-    for ext in [".gz", ".csv", ".sto"] {
+    for ext in [".gz", ".csv", ".sto", ".xml"] {
         if lower[..stem_len].ends_with(ext) {
             stem_len -= ext.len();
         }
@@ -185,7 +189,7 @@ pub struct SaveRequest<'a> {
 impl SaveRequest<'_> {
     /// The sidecar record of this correction (reads the input file for its hash).
     pub fn sidecar(&self) -> anyhow::Result<Sidecar> {
-        let bytes = std::fs::read(self.input)
+        let bytes = crate::trial::input_bytes(self.input)
             .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", self.input.display()))?;
         let input = InputRecord {
             file: self.input.display().to_string(),
@@ -221,11 +225,16 @@ impl SaveRequest<'_> {
     /// Writes the corrected trial and its sidecar, each atomically (previous
     /// files are kept as `.bak`). Returns the sidecar's path.
     pub fn save(&self) -> anyhow::Result<PathBuf> {
+        self.save_with(self.sidecar()?)
+    }
+
+    /// Writes the corrected trial and the given sidecar (built by
+    /// [`SaveRequest::sidecar`], perhaps amended), as [`SaveRequest::save`] does.
+    pub fn save_with(&self, sidecar: Sidecar) -> anyhow::Result<PathBuf> {
         if let Some(dir) = self.output.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| anyhow::anyhow!("{}: cannot create folder: {e}", dir.display()))?;
         }
-        let sidecar = self.sidecar()?;
         write_trial(&self.correction.corrected, self.output, self.output_format)?;
         let path = self
             .sidecar

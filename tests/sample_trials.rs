@@ -16,6 +16,7 @@ fn sample_trials_match_their_truth() {
         "knee_calf_z15.csv.gz",
         "full_body_clean.csv.gz",
         "full_body_drift.csv.gz",
+        "elbow_20.csv.gz",
     ];
     for name in names {
         let path = dir.join(name);

@@ -11,6 +11,7 @@ use super::window::{correction_series, layout, whole_trial, Window};
 use super::{
     Cancelled, Correction, JointResult, RunControl, SkippedJoint, Variant, WindowSolution,
 };
+use crate::baselines;
 use crate::limits::{JointLimits, LimitTable, Settings};
 use crate::model::{Joint, Model};
 use crate::rotation::{angle_deg, canonical, quat_from_wxyz, wxyz, Quat};
@@ -154,15 +155,28 @@ fn run(
                         p(d, total);
                     }
                 };
-                let sol = solve_windows(
-                    &trial.time_s,
-                    &measured,
-                    &windows,
-                    lim,
-                    settings.lambda1,
-                    control,
-                    &progress,
-                )?;
+                let (sol, baseline) = match baselines::method_for(variant, &joint.kind) {
+                    Some(method) => solve_baseline(
+                        method,
+                        &trial.time_s,
+                        &measured,
+                        &windows,
+                        control,
+                        &progress,
+                    )?,
+                    None => (
+                        solve_windows(
+                            &trial.time_s,
+                            &measured,
+                            &windows,
+                            lim,
+                            settings.lambda1,
+                            control,
+                            &progress,
+                        )?,
+                        None,
+                    ),
+                };
                 let result = JointResult {
                     joint: joint.name.clone(),
                     proximal: joint.proximal.clone(),
@@ -170,6 +184,7 @@ fn run(
                     lambda2: lim.lambda2,
                     parent_corrected,
                     windows: sol.windows,
+                    baseline,
                 };
                 Ok((*k, result, Applied::Series(sol.series)))
             })
@@ -209,6 +224,27 @@ enum Applied {
     Series(Vec<Quat>),
     /// The corrected orientations of an earlier run, kept as they were.
     Kept(Vec<Quat>),
+}
+
+/// Solves one joint with a baseline method (Rivest, Mueller) instead of the ACM.
+fn solve_baseline(
+    method: baselines::Method,
+    time_s: &[f64],
+    measured: &[Quat],
+    windows: &[Window],
+    control: &RunControl,
+    progress: &(dyn Fn() + Sync),
+) -> Result<(JointSolution, Option<baselines::BaselineRecord>), Cancelled> {
+    if control.cancelled() {
+        return Err(Cancelled);
+    }
+    let b = baselines::solve_joint(method, time_s, measured, windows);
+    windows.iter().for_each(|_| progress());
+    let sol = JointSolution {
+        windows: b.windows,
+        series: b.series,
+    };
+    Ok((sol, Some(b.record)))
 }
 
 /// Solves one joint: the measured joint rotations `Rm_i` (parent' to child), per sample.

@@ -40,11 +40,21 @@ pub enum Variant {
     Drift,
     /// Windows + slerp + the centroid term (lambda2 from the table).
     DriftCentroid,
+    /// Rivest (2005) for the knees, per drift window; `drift-centroid` elsewhere.
+    Rivest,
+    /// Mueller et al. (2017) axes for the elbows; `drift-centroid` elsewhere.
+    Mueller,
 }
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 3] = [Variant::Basic, Variant::Drift, Variant::DriftCentroid];
+    pub const ALL: [Variant; 5] = [
+        Variant::Basic,
+        Variant::Drift,
+        Variant::DriftCentroid,
+        Variant::Rivest,
+        Variant::Mueller,
+    ];
 
     /// The name used on the command line, in files and on screen.
     pub fn name(self) -> &'static str {
@@ -52,6 +62,8 @@ impl Variant {
             Variant::Basic => "basic",
             Variant::Drift => "drift",
             Variant::DriftCentroid => "drift-centroid",
+            Variant::Rivest => "rivest",
+            Variant::Mueller => "mueller",
         }
     }
 
@@ -67,7 +79,10 @@ impl Variant {
 
     /// Uses the table's centroid term.
     pub fn centroid(self) -> bool {
-        matches!(self, Variant::DriftCentroid)
+        matches!(
+            self,
+            Variant::DriftCentroid | Variant::Rivest | Variant::Mueller
+        )
     }
 }
 
@@ -111,6 +126,10 @@ pub struct JointResult {
     /// its own joint was skipped).
     pub parent_corrected: bool,
     pub windows: Vec<WindowSolution>,
+    /// What a baseline method found, for the joints a baseline variant
+    /// corrects (`rivest`, `mueller`); absent for ACM joints.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<crate::baselines::BaselineRecord>,
 }
 
 /// A joint the engine did not correct, and why.

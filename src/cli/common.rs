@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 /// Options of the correction engine, shared by `correct` and `report`.
 #[derive(Debug, Clone, Args, Default)]
 pub struct EngineArgs {
-    /// Body model: `infant13`, `opensim` or a model TOML file [default: the
+    /// Body model: `infant13`, `opensim`, `opensense_lower`, `full_body16` or a
+    /// model TOML file [default: the
     /// built-in model that knows most of the trial's IMUs].
     #[arg(long)]
     pub model: Option<String>,

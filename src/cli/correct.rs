@@ -27,6 +27,9 @@ pub struct CorrectArgs {
     /// (reproduces that run exactly).
     #[arg(long, conflicts_with_all = ["variant", "model", "limits", "lambda1", "window", "hop"])]
     pub from_sidecar: Option<PathBuf>,
+    /// Apply this functional calibration (`acmw calibrate`) to the trial first.
+    #[arg(long, conflicts_with = "from_sidecar")]
+    pub calibration: Option<PathBuf>,
     #[command(flatten)]
     pub engine: EngineArgs,
     /// No progress or summary output.
@@ -36,9 +39,15 @@ pub struct CorrectArgs {
 
 /// Runs `acmw correct`.
 pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
+    let mut recorded_calibration = None;
     let (ctx, variant) = match &args.from_sidecar {
         Some(p) => {
             let s = Sidecar::load(p)?;
+            recorded_calibration = s
+                .calibration
+                .as_ref()
+                .map(|c| c.reread(&p.display().to_string()))
+                .transpose()?;
             let limits = s.table(&p.display().to_string())?;
             set_threads(args.engine.threads);
             let ctx = Context {
@@ -52,13 +61,29 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         None => (load_context(&args.engine, Some(&args.input))?, args.variant),
     };
     let (in_format, gzip) = detect_format(&args.input)?;
-    let trial = read_trial(&args.input, &ctx.model)?;
+    let mut trial = read_trial(&args.input, &ctx.model)?;
+    let calibration = match recorded_calibration {
+        Some(c) => {
+            for w in c.apply(&mut trial, &ctx.model) {
+                if !args.quiet {
+                    eprintln!("warning: {w}");
+                }
+            }
+            Some(c)
+        }
+        None => super::calibrate::apply(
+            args.calibration.as_deref(),
+            &mut trial,
+            &ctx.model,
+            args.quiet,
+        )?,
+    };
     if !args.quiet {
         for w in &trial.warnings {
             eprintln!("warning: {w}");
         }
     }
-    let format = args.format.unwrap_or(in_format);
+    let format = args.format.unwrap_or(in_format.output_default());
     let output = args
         .output
         .clone()
@@ -78,7 +103,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         &control,
     )?;
     progress.finish();
-    let sc_path = SaveRequest {
+    let request = SaveRequest {
         input: &args.input,
         input_format: in_format,
         trial: &trial,
@@ -89,8 +114,10 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         output: &output,
         output_format: format,
         sidecar: args.sidecar.as_deref(),
-    }
-    .save()?;
+    };
+    let mut sidecar = request.sidecar()?;
+    sidecar.calibration = calibration;
+    let sc_path = request.save_with(sidecar)?;
     if !args.quiet {
         for s in &correction.skipped {
             eprintln!("skipped {}: {}", s.joint, s.reason);

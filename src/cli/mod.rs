@@ -8,6 +8,7 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
+mod calibrate;
 mod common;
 mod correct;
 mod render;
@@ -50,6 +51,8 @@ pub enum Command {
     Simulate(simulate::SimulateArgs),
     /// Print a workbench screen as text (trials, trial, compare, limits, help).
     Render(render::RenderArgs),
+    /// Functional calibration of a recording (Ricci et al. 2014): rho table, residuals, calibration file.
+    Calibrate(calibrate::CalibrateArgs),
 }
 
 /// Runs the parsed command line; returns the process exit code.
@@ -59,6 +62,7 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
         Some(Command::Render(a)) => render::run(a, &cli.theme),
+        Some(Command::Calibrate(a)) => calibrate::run(a),
         None => workbench(cli.dir, &cli.theme),
     };
     match result {
@@ -100,5 +104,6 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
         c.is::<acm_workbench::trial::TrialError>()
             || c.is::<acm_workbench::limits::LimitsError>()
             || c.is::<acm_workbench::model::ModelError>()
+            || c.is::<acm_workbench::calibration::CalibrationError>()
     })
 }

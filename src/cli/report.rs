@@ -18,6 +18,9 @@ pub struct ReportArgs {
     /// Print JSON instead of text tables.
     #[arg(long)]
     pub json: bool,
+    /// Apply this functional calibration (`acmw calibrate`) to the trial first.
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
     #[command(flatten)]
     pub engine: EngineArgs,
     /// No progress output.
@@ -28,7 +31,13 @@ pub struct ReportArgs {
 /// Runs `acmw report`.
 pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     let ctx = load_context(&args.engine, Some(&args.input))?;
-    let trial = read_trial(&args.input, &ctx.model)?;
+    let mut trial = read_trial(&args.input, &ctx.model)?;
+    super::calibrate::apply(
+        args.calibration.as_deref(),
+        &mut trial,
+        &ctx.model,
+        args.quiet,
+    )?;
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {
             let t = t?;

@@ -26,9 +26,16 @@ pub enum What {
     /// The 13 IMUs of infant13: crawling-like motion, random 5-30 deg misalignment
     /// of every non-base IMU, optional heading drift, noise.
     FullBody(FullBodyArgs),
-    /// A named configuration (knee_calf_z15, full_body_clean, full_body_drift);
+    /// Mueller et al. elbow test: static upper arm, forearm flexing 20-130 deg and
+    /// pronating +-28 deg, both IMUs tilted off their hinge axes (IMUs l_upper_arm
+    /// and l_forearm).
+    Elbow(ElbowArgs),
+    /// A named configuration (knee_calf_z15, full_body_clean, full_body_drift, elbow_20);
     /// the common options override it.
     Preset(PresetArgs),
+    /// A functional calibration recording (Ricci et al. 2014 protocol) with known
+    /// sensor-to-frame rotations, sloppy movements and noise.
+    Calibration(super::calibrate::SimulateCalibrationArgs),
 }
 
 #[derive(Debug, Args)]
@@ -42,6 +49,20 @@ pub struct KneeArgs {
     /// Misalignment angle, degrees.
     #[arg(long, default_value_t = 15.0, allow_negative_numbers = true)]
     pub angle: f64,
+    #[command(flatten)]
+    pub common: CommonArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct ElbowArgs {
+    /// Misalignment of each IMU about a random axis perpendicular to its hinge
+    /// axis, degrees.
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    pub angle: f64,
+    /// Further misalignment by a rotation vector in degrees in the sensor frame,
+    /// IMU:X:Y:Z (repeatable), e.g. a turn about the hinge axis.
+    #[arg(long = "misalign", value_parser = parse_misalignment, allow_hyphen_values = true)]
+    pub misalign: Vec<ImuMisalignment>,
     #[command(flatten)]
     pub common: CommonArgs,
 }
@@ -82,7 +103,7 @@ pub struct CommonArgs {
     /// Random seed [default: 0].
     #[arg(long)]
     pub seed: Option<u64>,
-    /// RMS orientation noise per sample, degrees [default: 0 for knee, 0.3 full body].
+    /// RMS orientation noise per sample, degrees [default: 0 knee, 0.3 full body, 0.5 elbow].
     #[arg(long)]
     pub noise: Option<f64>,
     /// Heading drift IMU:START_S:RATE_DEG_S about the global vertical (repeatable).
@@ -157,7 +178,15 @@ impl CommonArgs {
 /// Runs `acmw simulate`.
 pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
     let (mut cfg, common) = match args.what {
+        What::Calibration(a) => return super::calibrate::simulate_run(a),
         What::Knee(a) => (SimConfig::knee(a.imu, a.axis, a.angle), a.common),
+        What::Elbow(a) => {
+            let mut cfg = SimConfig::elbow(0, a.angle);
+            if !a.misalign.is_empty() {
+                cfg.misalignment = Misalignment::Fixed { imus: a.misalign };
+            }
+            (cfg, a.common)
+        }
         What::FullBody(a) => {
             let mut cfg = SimConfig::full_body(0);
             cfg.misalignment = if a.aligned {

@@ -30,6 +30,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 
+mod elbow;
 mod motion;
 #[cfg(test)]
 mod tests;
@@ -47,7 +48,15 @@ pub const KNEE_IMUS: [&str; 2] = ["l_thigh", "l_calf"];
 /// Default random misalignment angles, degrees.
 pub const RANDOM_MISALIGNMENT_DEG: [f64; 2] = [5.0, 30.0];
 /// Names accepted by [`preset`].
-pub const PRESETS: [&str; 3] = ["knee_calf_z15", "full_body_clean", "full_body_drift"];
+pub const PRESETS: [&str; 4] = [
+    "knee_calf_z15",
+    "full_body_clean",
+    "full_body_drift",
+    "elbow_20",
+];
+pub use elbow::{
+    flexion_deg as elbow_flexion_deg, pronation_deg as elbow_pronation_deg, ELBOW_IMUS,
+};
 
 /// What to simulate, for how long, and which errors to put into the sensors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -86,6 +95,12 @@ pub enum SimKind {
     /// The 13 IMUs of `infant13`: a moving base and smooth joint angles, mostly
     /// inside Table 3-2, around the Table 3-3 centroids (or the middle of the range).
     FullBody,
+    /// The Mueller et al. (2017) elbow test: IMUs `l_upper_arm` and `l_forearm`
+    /// only (joint `l_elbow`). The upper arm is static at identity; the forearm
+    /// flexes (X, 20-130 deg) and pronates/supinates (Z, +-28 deg) at once
+    /// (`simulate::elbow`). Each IMU is misaligned by `angle_deg` about a
+    /// random axis perpendicular to its hinge axis (upper arm Z, forearm X).
+    Elbow { angle_deg: f64 },
 }
 
 /// Which IMU of the knee test is misaligned.
@@ -202,6 +217,20 @@ impl SimConfig {
         }
     }
 
+    /// The elbow test (5 min at 50 Hz, 0.5 degree noise) with both IMUs
+    /// misaligned by `angle_deg`.
+    pub fn elbow(seed: u64, angle_deg: f64) -> SimConfig {
+        SimConfig {
+            kind: SimKind::Elbow { angle_deg },
+            duration_s: 300.0,
+            rate_hz: 50.0,
+            seed,
+            noise_deg: 0.5,
+            misalignment: Misalignment::None,
+            drifts: vec![],
+        }
+    }
+
     /// Number of samples: `round(duration_s * rate_hz)`.
     pub fn samples(&self) -> usize {
         (self.duration_s * self.rate_hz).round().max(0.0) as usize
@@ -212,6 +241,7 @@ impl SimConfig {
         match self.kind {
             SimKind::Knee { .. } => KNEE_IMUS.iter().map(|s| s.to_string()).collect(),
             SimKind::FullBody => model.imus.clone(),
+            SimKind::Elbow { .. } => ELBOW_IMUS.iter().map(|s| s.to_string()).collect(),
         }
     }
 
@@ -236,10 +266,10 @@ impl SimConfig {
                 self.noise_deg
             ));
         }
-        if let SimKind::Knee { angle_deg, .. } = self.kind {
+        if let SimKind::Knee { angle_deg, .. } | SimKind::Elbow { angle_deg } = self.kind {
             if !angle_deg.is_finite() {
                 return err(format!(
-                    "knee misalignment angle must be finite, found {angle_deg}"
+                    "misalignment angle must be finite, found {angle_deg}"
                 ));
             }
         }
@@ -301,10 +331,12 @@ impl SimConfig {
 /// 5 min, 50 Hz, no noise), `full_body_clean` (13 IMUs, 90 s, 50 Hz, seed 1,
 /// random 5-30 degree misalignment, 0.3 degree noise, no drift), `full_body_drift`
 /// (as clean but 300 s, seed 2, heading drift on `l_calf` from 60 s at 0.05 deg/s
-/// and on `r_upper_arm` from 30 s at 0.08 deg/s).
+/// and on `r_upper_arm` from 30 s at 0.08 deg/s), `elbow_20` (elbow test, both
+/// IMUs 20 degrees off their hinge axes, 5 min, 50 Hz, seed 3, 0.5 degree noise).
 pub fn preset(name: &str) -> Option<SimConfig> {
     match name {
         "knee_calf_z15" => Some(SimConfig::knee(KneeImu::Calf, KneeAxis::Z, 15.0)),
+        "elbow_20" => Some(SimConfig::elbow(3, 20.0)),
         "full_body_clean" => Some(SimConfig {
             duration_s: 90.0,
             ..SimConfig::full_body(1)
@@ -335,6 +367,7 @@ enum Stream {
     Motion = 1,
     Misalignment = 2,
     Noise = 3,
+    ElbowMisalignment = 4,
 }
 
 fn rng(seed: u64, stream: Stream) -> ChaCha8Rng {
@@ -354,6 +387,7 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
     let segments: Vec<(String, Vec<Quat>)> = match config.kind {
         SimKind::Knee { .. } => knee_segments(&time_s),
         SimKind::FullBody => full_body_segments(&model, config.seed, &time_s),
+        SimKind::Elbow { .. } => elbow::segments(&time_s),
     };
 
     let misalignments = misalignments(config, &model, &segments);
@@ -424,6 +458,7 @@ fn kind_label(kind: &SimKind) -> String {
     match kind {
         SimKind::Knee { .. } => "simulated-knee".into(),
         SimKind::FullBody => "simulated-full-body".into(),
+        SimKind::Elbow { .. } => "simulated-elbow".into(),
     }
 }
 
@@ -502,6 +537,9 @@ fn misalignments(
         if let Some(imu) = imu {
             out.insert(imu.into(), rotation::quat_axis_angle_deg(axis, angle_deg));
         }
+    }
+    if let SimKind::Elbow { angle_deg } = config.kind {
+        out.extend(elbow::misalignments(config.seed, angle_deg).map(|(n, m)| (n.to_string(), m)));
     }
     match &config.misalignment {
         Misalignment::None => {}

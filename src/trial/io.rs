@@ -22,7 +22,7 @@ use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Read, Write as _};
 use std::path::Path;
 
-mod parse;
+pub(crate) mod parse;
 #[cfg(test)]
 mod tests;
 
@@ -85,10 +85,44 @@ fn kind_or_err(path: &Path) -> Result<(Kind, bool), TrialError> {
     })
 }
 
+/// True when `path` names an Xsens trial: a folder, or an `.xml` mapping file.
+fn is_xsens_path(path: &Path) -> bool {
+    path.is_dir()
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
+/// True when `path` is a trial the workbench lists: a trial file
+/// ([`is_trial_file`]), an OpenSense mapping XML, or a folder of Xsens exports.
+pub fn is_trial_path(path: &Path) -> bool {
+    use super::xsens_trial::{is_export_folder, is_mapping_file};
+    if path.is_dir() {
+        is_export_folder(path)
+    } else {
+        is_trial_file(path) || is_mapping_file(path)
+    }
+}
+
+/// The bytes that identify a trial's input for the sidecar's hash: the file, or
+/// for Xsens trials the mapping followed by every export.
+pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
+    if is_xsens_path(path) {
+        super::xsens_trial::input_bytes(path)
+    } else {
+        std::fs::read(path)
+    }
+}
+
 /// True when `path`'s name is a trial file: it ends in `.csv`, `.sto`, `.csv.gz` or
 /// `.sto.gz` and is not a truth file (`*.truth.csv`, `*.truth.sto`, optionally `.gz`).
-/// Sidecars (`.json`), backups (`.bak`) and temporary files never qualify.
+/// Sidecars (`.json`), backups (`.bak`), temporary files and calibration
+/// recordings (`*.calib.csv`, see [`crate::calibration::is_calibration_recording`])
+/// never qualify.
 pub fn is_trial_file(path: &Path) -> bool {
+    if crate::calibration::is_calibration_recording(path) {
+        return false;
+    }
     let Some(name) = path.file_name() else {
         return false;
     };
@@ -211,6 +245,9 @@ fn read_head(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> 
 /// `_roll/_pitch/_yaw`), `*.sto` is [`TrialFormat::Sto`]; each optionally `.gz`.
 /// Reads only the first line of a CSV file.
 pub fn detect_format(path: &Path) -> Result<(TrialFormat, bool), TrialError> {
+    if is_xsens_path(path) {
+        return Ok((TrialFormat::Xsens, false));
+    }
     let (kind, gzip) = kind_or_err(path)?;
     match kind {
         Kind::Sto => Ok((TrialFormat::Sto, gzip)),
@@ -232,6 +269,9 @@ pub fn detect_format(path: &Path) -> Result<(TrialFormat, bool), TrialError> {
 /// Reads a trial, picking the format from the file name (`.csv`, `.sto`,
 /// optionally `.gz`) and, for CSV, the header. `Trial::name` is the file name.
 pub fn read_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
+    if is_xsens_path(path) {
+        return super::xsens_trial::read_xsens_trial(path, model);
+    }
     let (kind, gzip) = kind_or_err(path)?;
     let text = read_text(path, kind, gzip)?;
     let format = match kind {
@@ -256,6 +296,20 @@ pub fn read_trial_from_str(
 /// Reads only the header of a trial file: format, compression and IMU names.
 /// The header is checked as [`read_trial`] would check it.
 pub fn read_trial_header(path: &Path, model: &Model) -> Result<TrialHeader, TrialError> {
+    if is_xsens_path(path) {
+        let (known, unknown): (Vec<String>, Vec<String>) = super::xsens_trial::imu_names(path)?
+            .into_iter()
+            .partition(|n| model.canonical_imu(n).is_some());
+        return Ok(TrialHeader {
+            format: TrialFormat::Xsens,
+            gzip: false,
+            imus: known
+                .iter()
+                .filter_map(|n| model.canonical_imu(n).map(str::to_string))
+                .collect(),
+            unknown_imus: unknown,
+        });
+    }
     let (kind, gzip) = kind_or_err(path)?;
     let head = read_head(path, kind, gzip)?;
     let format = match kind {
@@ -277,6 +331,12 @@ pub fn read_trial_header(path: &Path, model: &Model) -> Result<TrialHeader, Tria
 /// Atomic, keeping the previous file as `<name>.bak` ([`crate::save::atomic_write`]).
 pub fn write_trial(trial: &Trial, path: &Path, format: TrialFormat) -> Result<(), TrialError> {
     let origin = origin_of(path);
+    if format == TrialFormat::Xsens {
+        return Err(TrialError::file(
+            origin,
+            "cannot write Xsens exports: expected quat-csv, euler-csv or sto",
+        ));
+    }
     if let Some(bad) = trial
         .imus
         .iter()
@@ -366,7 +426,7 @@ pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
                 out.push('\n');
             }
         }
-        TrialFormat::Sto => {
+        TrialFormat::Sto | TrialFormat::Xsens => {
             let _ = write!(
                 out,
                 "\nDataRate={:.6}\nDataType=Quaternion\nversion=3\nOpenSimVersion=4.1\nendheader\ntime",

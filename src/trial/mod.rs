@@ -10,6 +10,9 @@ use serde::{Deserialize, Serialize};
 
 mod error;
 mod io;
+pub mod mapping;
+pub mod xsens;
+pub mod xsens_trial;
 
 pub use error::TrialError;
 pub use io::*;
@@ -46,6 +49,21 @@ pub enum TrialFormat {
     EulerCsv,
     /// OpenSim orientation `.sto` (OpenSense), tab-separated `w,x,y,z` cells.
     Sto,
+    /// Xsens MT Manager exports, one `.txt` per sensor, named by a mapping XML or
+    /// a folder (read only; corrected trials are written as `.sto`).
+    #[value(skip)]
+    Xsens,
+}
+
+impl TrialFormat {
+    /// The format a corrected trial is written in by default: the input's own,
+    /// or `.sto` (what OpenSense makes of them) for Xsens exports.
+    pub fn output_default(self) -> TrialFormat {
+        match self {
+            TrialFormat::Xsens => TrialFormat::Sto,
+            f => f,
+        }
+    }
 }
 
 impl Trial {
@@ -90,18 +108,24 @@ impl Trial {
     }
 }
 
-/// The built-in model that recognises most IMUs of the trial at `path` (from
-/// its header only); the first built-in model when none recognises any.
+/// The built-in model that fits the trial at `path` best (from its header or
+/// mapping only): the one that recognises most of its IMUs, and among those the
+/// one with fewest IMUs the trial lacks (so an 8-sensor OpenSense trial gets
+/// `opensense_lower`, not the 12-IMU `opensim`); the first built-in model when
+/// none recognises any.
 pub fn detect_model(path: &std::path::Path) -> crate::model::Model {
     use crate::model::{Model, BUILTIN_MODELS};
-    let mut best: Option<(usize, Model)> = None;
+    let mut best: Option<((usize, usize), Model)> = None;
     for (name, _) in BUILTIN_MODELS {
         let model = Model::builtin(name).expect("built-in model is valid");
         let known = read_trial_header(path, &model)
             .map(|h| h.imus.iter().filter(|i| model.imus.contains(i)).count())
             .unwrap_or(0);
-        if best.as_ref().is_none_or(|(k, _)| known > *k) {
-            best = Some((known, model));
+        let lacking = model.imus.len() - known.min(model.imus.len());
+        // Larger is better: most known first, then fewest lacking.
+        let score = (known, usize::MAX - lacking);
+        if best.as_ref().is_none_or(|(s, _)| known > 0 && score > *s) {
+            best = Some((score, model));
         }
     }
     best.expect("there are built-in models").1

@@ -25,19 +25,36 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let truth = e.loaded().is_some_and(|l| l.truth.is_some());
     let cw = if truth { 14 } else { 8 };
     let nw = 12usize;
-    let mut lines = vec![Line::from(Span::styled(
-        if truth {
-            "joint mean excursion, deg  /  truth RMS error, deg (mean of X Y Z)"
-        } else {
-            "joint mean excursion, deg"
-        },
-        theme.dim,
-    ))];
+    let cols = visible_columns(
+        area.width as usize,
+        2 + nw + cw,
+        cw.max(15),
+        app.compare_col,
+    );
+    let mut title = if truth {
+        "joint mean excursion, deg  /  truth RMS error, deg (mean of X Y Z)".to_string()
+    } else {
+        "joint mean excursion, deg".to_string()
+    };
+    if cols.len() < Variant::ALL.len() {
+        title.push_str(&format!(
+            " [{}-{} of {}]",
+            cols.start + 1,
+            cols.end,
+            Variant::ALL.len()
+        ));
+    }
+    let mut lines = vec![Line::from(Span::styled(title, theme.dim))];
     let mut head = vec![Span::styled(
         format!("  {}{:>w$}", fit("joint", nw), "raw", w = cw),
         theme.header,
     )];
-    for (k, v) in Variant::ALL.iter().enumerate() {
+    for (k, v) in Variant::ALL
+        .iter()
+        .enumerate()
+        .skip(cols.start)
+        .take(cols.len())
+    {
         let mut name = v.name().to_string();
         if e.chosen == Some(*v) {
             name = format!("*{name}");
@@ -66,7 +83,8 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let mut rows: Vec<(String, Vec<String>)> = vec![];
     for (k, j) in before.iter().enumerate() {
         let mut cells = vec![cell(Some(j))];
-        for v in Variant::ALL {
+        for v in &Variant::ALL[cols.clone()] {
+            let v = *v;
             let fig = e
                 .figures(Some(v))
                 .and_then(|fs| fs.iter().find(|f| f.joint == j.joint));
@@ -77,13 +95,14 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     }
     // Mean over joints.
     let mut mean = vec![num(e.mean_excursion(None), 6)];
-    for v in Variant::ALL {
+    for v in &Variant::ALL[cols.clone()] {
+        let v = *v;
         mean.push(num(e.mean_excursion(Some(v)), 6));
     }
     for (k, (name, cells)) in rows.iter().enumerate() {
         let mut spans = vec![Span::raw(format!("{name}{:>w$}", cells[0], w = cw))];
         for (c, text) in cells[1..].iter().enumerate() {
-            let style = if c == app.compare_col {
+            let style = if cols.start + c == app.compare_col {
                 theme.corrected
             } else {
                 Style::default()
@@ -137,4 +156,18 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         )));
     }
     f.render_widget(Paragraph::new(lines), area);
+}
+
+/// The variant columns (indices into `Variant::ALL`) that fit in `width`
+/// after `fixed` characters, `col_w` each, scrolled to show `selected`.
+fn visible_columns(
+    width: usize,
+    fixed: usize,
+    col_w: usize,
+    selected: usize,
+) -> std::ops::Range<usize> {
+    let all = Variant::ALL.len();
+    let fit = (width.saturating_sub(fixed) / col_w.max(1)).clamp(1, all);
+    let start = selected.min(all - 1).saturating_sub(fit - 1);
+    start..start + fit
 }

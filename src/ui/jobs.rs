@@ -8,21 +8,36 @@ use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
 use crate::report::ReportInput;
 use crate::sidecar::{default_output, SaveRequest};
-use crate::trial::{detect_format, detect_model, is_trial_file, read_trial, TrialError};
+use crate::trial::xsens_trial::{is_mapping_file, resolve};
+use crate::trial::{detect_format, detect_model, is_trial_path, read_trial, TrialError};
 use crate::truth::load_truth_beside;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-/// Trial file names in `dir` (non-recursive), sorted.
+/// Trial names in `dir` (non-recursive), sorted: trial files, OpenSense
+/// mapping XMLs, and folders of Xsens exports that no listed mapping reads.
 pub fn list_trials(dir: &Path) -> Result<Vec<String>, String> {
     let rd = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let mut names: Vec<String> = rd
+    let paths: Vec<PathBuf> = rd
         .filter_map(|e| e.ok())
-        .filter(|e| e.file_type().map(|t| !t.is_dir()).unwrap_or(false))
         .map(|e| e.path())
-        .filter(|p| is_trial_file(p))
+        .filter(|p| is_trial_path(p))
+        .collect();
+    let read_by_mapping: Vec<PathBuf> = paths
+        .iter()
+        .filter(|p| p.is_file() && is_mapping_file(p))
+        .filter_map(|xml| resolve(xml).ok())
+        .flat_map(|s| {
+            s.files
+                .into_iter()
+                .filter_map(|(f, _)| f.parent().map(Path::to_path_buf))
+        })
+        .collect();
+    let mut names: Vec<String> = paths
+        .iter()
+        .filter(|p| !(p.is_dir() && read_by_mapping.contains(p)))
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
     names.sort();
@@ -159,7 +174,12 @@ pub fn save_variant(
     limits: &LimitTable,
     limits_source: &str,
 ) -> Msg {
-    let output = default_output(path, correction.variant, loaded.format, loaded.gzip);
+    let output = default_output(
+        path,
+        correction.variant,
+        loaded.format.output_default(),
+        loaded.gzip,
+    );
     let req = SaveRequest {
         input: path,
         input_format: loaded.format,
@@ -169,7 +189,7 @@ pub fn save_variant(
         limits,
         limits_source,
         output: &output,
-        output_format: loaded.format,
+        output_format: loaded.format.output_default(),
         sidecar: None,
     };
     let shown = output

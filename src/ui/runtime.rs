@@ -8,7 +8,12 @@ use super::app::{update, App, Effect, Msg};
 use super::jobs::{self, list_trials, load_limits, read_limits_on_disk};
 use super::render::render;
 use super::theme::Theme;
-use crate::trial::is_trial_file;
+use crate::trial::{is_trial_file, is_trial_path};
+
+/// An `.xml` name (a mapping that may just have been removed).
+fn is_xml(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
 use crossbeam_channel::{unbounded, Receiver, Sender};
 use notify::RecursiveMode;
 use notify_debouncer_full::{new_debouncer, DebounceEventResult};
@@ -161,13 +166,15 @@ fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
     watch_folder(dir, move |paths| {
         let names: BTreeSet<String> = paths
             .iter()
-            .filter(|p| is_trial_file(p))
+            .filter(|p| is_trial_file(p) || is_xml(p) || p.is_dir())
             .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
             .collect();
         for name in names {
             let path = d.join(&name);
-            let msg = if path.is_file() {
+            let msg = if is_trial_path(&path) {
                 Msg::FileChanged(name, path)
+            } else if path.exists() {
+                continue;
             } else {
                 Msg::FileRemoved(name)
             };

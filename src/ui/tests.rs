@@ -142,7 +142,7 @@ fn trial_flow_run_compare_save() {
     assert!(app.open_entry().unwrap().results.is_empty());
     keys(&mut app, "r");
     let e = app.open_entry().unwrap();
-    assert_eq!(e.results.len(), 3);
+    assert_eq!(e.results.len(), Variant::ALL.len());
     assert_eq!(e.running, None);
     // Zoom, pan, cursor, variant, joint.
     keys(&mut app, "++");
@@ -189,6 +189,33 @@ fn trial_flow_run_compare_save() {
     assert!(!app.unsaved());
     keys(&mut app, "q");
     assert!(app.quit);
+}
+
+#[test]
+fn compare_scrolls_to_the_baselines_and_saves_one() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    app.select_file("fb.csv.gz");
+    key(&mut app, KeyCode::Enter);
+    keys(&mut app, "r");
+    keys(&mut app, "c");
+    for _ in 0..Variant::ALL.len() {
+        key(&mut app, KeyCode::Right);
+    }
+    assert_eq!(Variant::ALL[app.compare_col], Variant::Mueller);
+    key(&mut app, KeyCode::Char(' '));
+    assert_eq!(app.open_entry().unwrap().chosen, Some(Variant::Mueller));
+    // At 80 columns the variants scroll: rivest and mueller are in view.
+    snap("compare_baselines", &app);
+    keys(&mut app, "w");
+    let out = fx.root().join("trials/corrected/fb.mueller.csv.gz");
+    assert!(out.exists(), "{:?}", app.message);
+    let sc = crate::sidecar::Sidecar::load(&crate::sidecar::sidecar_path(&out)).unwrap();
+    assert_eq!(sc.variant, Variant::Mueller);
+    for j in &sc.joints {
+        let is_elbow = j.joint.ends_with("elbow");
+        assert_eq!(j.baseline.is_some(), is_elbow, "{}", j.joint);
+    }
 }
 
 fn limits_app(fx: &Fixture) -> App {

@@ -20,11 +20,28 @@ pub fn variant_status(e: &TrialEntry, v: Variant) -> String {
     }
 }
 
+/// A variant's name in a 7-character column.
+fn short_name(v: Variant) -> &'static str {
+    match v {
+        Variant::DriftCentroid => "d+c",
+        Variant::Mueller => "muell",
+        v => v.name(),
+    }
+}
+
 pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let details_h = if area.height >= 16 { 5 } else { 0 };
     let [list, details] =
         Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area);
-    let fixed = 2 + 8 + 6 + 5 + 3 * 7 + 7 + 7;
+    // Variant status columns: all that fit beside a 20-character name, at
+    // least the three ACM variants (the baselines show on wider terminals).
+    let base = 2 + 8 + 6 + 5 + 7 + 7;
+    let shown = (3..=Variant::ALL.len())
+        .rev()
+        .find(|k| list.width as usize >= base + k * 7 + 20)
+        .unwrap_or(3);
+    let variants = &Variant::ALL[..shown];
+    let fixed = base + shown * 7;
     let nw = (list.width as usize).saturating_sub(fixed).max(8);
     let filter = if app.filter_editing || !app.filter.is_empty() {
         format!(
@@ -37,14 +54,15 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     };
     let mut lines = vec![Line::from(Span::styled(
         format!(
-            "  {}{:>8}{:>6}{:>5}{:>7}{:>7}{:>7}{:>7}{:>7}",
+            "  {}{:>8}{:>6}{:>5}{}{:>7}{:>7}",
             fit(&format!("trial (sort: {}){filter}", app.sort.name()), nw),
             "dur s",
             "Hz",
             "IMUs",
-            "basic",
-            "drift",
-            "d+c",
+            variants
+                .iter()
+                .map(|v| format!("{:>7}", short_name(*v)))
+                .collect::<String>(),
             "exc",
             app.variant.name().chars().take(6).collect::<String>(),
         ),
@@ -77,7 +95,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                     l.trial.rate_hz(),
                     l.trial.imus.len()
                 );
-                for v in Variant::ALL {
+                for &v in variants {
                     s.push_str(&format!("{:>7}", variant_status(e, v)));
                 }
                 s.push_str(&num(e.mean_excursion(None), 7));

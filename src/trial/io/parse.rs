@@ -133,11 +133,13 @@ fn empty_file(origin: &str, format: TrialFormat) -> TrialError {
         TrialFormat::QuatCsv => "a header line 'time,<imu>_qw,<imu>_qx,<imu>_qy,<imu>_qz,...'",
         TrialFormat::EulerCsv => "a header line 'time,<imu>_roll,<imu>_pitch,<imu>_yaw,...'",
         TrialFormat::Sto => "an OpenSim .sto header (DataRate=..., DataType=Quaternion, endheader)",
+        TrialFormat::Xsens => "an Xsens MT Manager export (read through its folder or mapping XML)",
     };
     TrialError::at(origin, 1, 1, format!("empty file: expected {what}"))
 }
 
-/// Checks the first label is `time` and there is at least one more.
+/// Checks the first label is `time` (or `time_s`, seconds either way) and there
+/// is at least one more.
 fn check_time_and_count(
     origin: &str,
     line: u64,
@@ -145,13 +147,13 @@ fn check_time_and_count(
     what: &str,
 ) -> Result<(), TrialError> {
     let first = labels.first().map(String::as_str).unwrap_or("");
-    if !first.eq_ignore_ascii_case("time") {
+    if !(first.eq_ignore_ascii_case("time") || first.eq_ignore_ascii_case("time_s")) {
         return Err(TrialError::at(
             origin,
             line,
             1,
             format!(
-                "expected the first column to be 'time', found {}",
+                "expected the first column to be 'time', found {} ('time_s' is accepted too; seconds)",
                 show(first)
             ),
         ));
@@ -596,6 +598,9 @@ pub(crate) fn parse_trial(
     format: TrialFormat,
     model: &Model,
 ) -> Result<Trial, TrialError> {
+    if format == TrialFormat::Xsens {
+        return Err(empty_file(origin, format));
+    }
     let mut lines = LineIter::new(text);
     let layout = parse_header(&mut lines, origin, format, model)?;
     let mut acc = Acc::new(origin, layout.imus.len());
@@ -635,7 +640,7 @@ pub(crate) fn parse_trial(
                 }
             }
         }
-        TrialFormat::Sto => {
+        TrialFormat::Sto | TrialFormat::Xsens => {
             const PARTS: [&str; 4] = ["w", "x", "y", "z"];
             for (line, text) in lines.by_ref() {
                 if text.trim().is_empty() {

@@ -1,0 +1,264 @@
+//! The single-joint methods the source compares the ACM against (METHOD.md
+//! section 7): Rivest (2005) for knees, Mueller et al. (2017) for elbows.
+//!
+//! Each runs as a variant of the whole-trial correction (`rivest`, `mueller`):
+//! the joints of its kind get the baseline, every other joint the ACM's
+//! `drift-centroid` (the chain runs as usual, so a child of a baseline joint is
+//! measured against the baseline's corrected orientation). Both methods correct
+//! the proximal and the distal IMU of their joint; the proximal IMU is also the
+//! distal IMU of its parent joint, whose angles must stay that joint's, so both
+//! corrections are carried by the distal IMU: `G_R_dist' = G_R_prox' Rt'`, with
+//! `Rt'` the baseline's corrected joint rotation. As a per-sample correction of
+//! the distal IMU that is `C(t) = Rm(t)^-1 Rt'(t)`.
+
+pub mod mueller;
+pub mod rivest;
+
+use crate::acm::window::Window;
+use crate::acm::{Variant, WindowSolution};
+use crate::rotation::{angle_deg, canonical, euler_zyx_deg, quat_from_euler_zyx_deg, wxyz, Quat};
+use mueller::{estimate_axes, rates_from_orientations, MuellerFit, MuellerOptions};
+use rivest::RivestFit;
+use serde::{Deserialize, Serialize};
+
+/// A baseline method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// Rivest (2005), for joints of kind `knee`.
+    Rivest,
+    /// Mueller et al. (2017), for joints of kind `elbow`.
+    Mueller,
+}
+
+impl Method {
+    /// The joint kind (limit-table row) the method is made for.
+    pub fn joint_kind(self) -> &'static str {
+        match self {
+            Method::Rivest => "knee",
+            Method::Mueller => "elbow",
+        }
+    }
+}
+
+/// The baseline that corrects a joint of `kind` in `variant`, if any.
+pub fn method_for(variant: Variant, kind: &str) -> Option<Method> {
+    let m = match variant {
+        Variant::Rivest => Method::Rivest,
+        Variant::Mueller => Method::Mueller,
+        _ => return None,
+    };
+    (m.joint_kind() == kind).then_some(m)
+}
+
+/// What a baseline found for one joint (kept in the sidecar).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "kebab-case")]
+pub enum BaselineRecord {
+    /// Rivest's four corrections per window (degrees), in window order; between
+    /// window centres they are interpolated linearly.
+    Rivest { fits: Vec<RivestFit> },
+    /// Mueller's axes (one estimate for the whole trial); `None` when the joint
+    /// moved too little to estimate them (the joint is then left as measured).
+    Mueller { fit: Option<MuellerFit> },
+}
+
+/// A baseline's solution of one joint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BaselineSolution {
+    /// Per window: `correction` is the mean of the applied correction `C(t)`
+    /// over the window and `angle_deg` its angle; `cost` and
+    /// `cost_uncorrected` are the method's own cost (Rivest: eq. 2.12 per
+    /// sample, deg^2; Mueller: J of eq. 2.25) at the solution and with no
+    /// correction; `evaluations` counts gradient-descent iterations (Mueller)
+    /// or 1 (Rivest's closed form).
+    pub windows: Vec<WindowSolution>,
+    /// `C(t)` per sample (sensor frame of the distal IMU).
+    pub series: Vec<Quat>,
+    pub record: BaselineRecord,
+}
+
+/// Solves one joint with `method` from the measured joint rotations `Rm_i`
+/// (parent' to child). Rivest fits each of `windows`; Mueller fits the whole
+/// trial once (the axes are fixed in the sensors) and reports it per window.
+pub fn solve_joint(
+    method: Method,
+    time_s: &[f64],
+    measured: &[Quat],
+    windows: &[Window],
+) -> BaselineSolution {
+    match method {
+        Method::Rivest => solve_rivest(time_s, measured, windows),
+        Method::Mueller => solve_mueller(time_s, measured, windows),
+    }
+}
+
+fn solve_rivest(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> BaselineSolution {
+    let angles: Vec<[f64; 3]> = measured.iter().map(euler_zyx_deg).collect();
+    let fits: Vec<RivestFit> = windows
+        .iter()
+        .map(|w| rivest::fit(&angles[w.first..w.end]))
+        .collect();
+    let centres: Vec<f64> = windows.iter().map(|w| w.centre_s).collect();
+    let per_sample = interpolate(time_s, &centres, &fits);
+    let series: Vec<Quat> = measured
+        .iter()
+        .zip(&angles)
+        .zip(&per_sample)
+        .map(|((rm, a), f)| rm.inverse() * quat_from_euler_zyx_deg(f.correct(*a)))
+        .collect();
+    let windows_out = windows
+        .iter()
+        .zip(&fits)
+        .map(|(w, f)| {
+            let a = &angles[w.first..w.end];
+            window_solution(w, &series, f.cost(a), RivestFit::default().cost(a), 1)
+        })
+        .collect();
+    BaselineSolution {
+        windows: windows_out,
+        series,
+        record: BaselineRecord::Rivest { fits },
+    }
+}
+
+/// Per-sample fits: the first before the first centre, the last after the last,
+/// linear between neighbouring centres (seconds from the first sample).
+fn interpolate(time_s: &[f64], centres_s: &[f64], fits: &[RivestFit]) -> Vec<RivestFit> {
+    let Some(&t0) = time_s.first() else {
+        return Vec::new();
+    };
+    let mut k = 0;
+    time_s
+        .iter()
+        .map(|&t| {
+            let rel = t - t0;
+            if rel < centres_s[0] {
+                return fits[0];
+            }
+            while k + 1 < centres_s.len() && rel >= centres_s[k + 1] {
+                k += 1;
+            }
+            if k + 1 == centres_s.len() {
+                return fits[k];
+            }
+            let f = (rel - centres_s[k]) / (centres_s[k + 1] - centres_s[k]);
+            fits[k].lerp(&fits[k + 1], f)
+        })
+        .collect()
+}
+
+fn solve_mueller(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> BaselineSolution {
+    let opts = MuellerOptions::default();
+    let rates = rates_from_orientations(time_s, measured, opts.rate_half_span_s);
+    let fit = estimate_axes(measured, &rates, &opts);
+    let series: Vec<Quat> = match &fit {
+        Some(f) => measured
+            .iter()
+            .map(|rm| rm.inverse() * f.correct(rm))
+            .collect(),
+        None => vec![Quat::identity(); measured.len()],
+    };
+    let (cost, cost_nominal, iterations) = fit
+        .map(|f| (f.cost, f.cost_nominal, f.iterations))
+        .unwrap_or((0.0, 0.0, 0));
+    let windows_out = windows
+        .iter()
+        .map(|w| window_solution(w, &series, cost, cost_nominal, iterations))
+        .collect();
+    BaselineSolution {
+        windows: windows_out,
+        series,
+        record: BaselineRecord::Mueller { fit },
+    }
+}
+
+/// A window's record: the mean applied correction over the window.
+fn window_solution(
+    w: &Window,
+    series: &[Quat],
+    cost: f64,
+    cost_uncorrected: f64,
+    evaluations: usize,
+) -> WindowSolution {
+    let mean = mean_rotation(&series[w.first..w.end]);
+    WindowSolution {
+        start_s: w.start_s,
+        end_s: w.end_s,
+        centre_s: w.centre_s,
+        samples: w.len(),
+        correction: wxyz(&mean),
+        angle_deg: angle_deg(&mean),
+        cost,
+        cost_uncorrected,
+        evaluations,
+    }
+}
+
+/// The normalised sum of sign-aligned quaternions (identity when empty).
+fn mean_rotation(qs: &[Quat]) -> Quat {
+    let Some(first) = qs.first() else {
+        return Quat::identity();
+    };
+    let r = first.into_inner();
+    let sum = qs
+        .iter()
+        .fold(nalgebra::Quaternion::new(0.0, 0.0, 0.0, 0.0), |s, q| {
+            let q = q.into_inner();
+            if q.dot(&r) < 0.0 {
+                s - q
+            } else {
+                s + q
+            }
+        });
+    canonical(&Quat::from_quaternion(sum))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::acm::window::{layout, whole_trial};
+    use crate::rotation::quat_axis_angle_deg;
+
+    #[test]
+    fn only_the_methods_joint_kind_gets_the_baseline() {
+        assert_eq!(method_for(Variant::Rivest, "knee"), Some(Method::Rivest));
+        assert_eq!(method_for(Variant::Rivest, "elbow"), None);
+        assert_eq!(method_for(Variant::Mueller, "elbow"), Some(Method::Mueller));
+        assert_eq!(method_for(Variant::Mueller, "knee"), None);
+        assert_eq!(method_for(Variant::DriftCentroid, "knee"), None);
+    }
+
+    #[test]
+    fn rivest_series_carries_the_corrected_angles_and_interpolates_windows() {
+        // Calf rotated 8 deg about X for the first half, 12 deg after: a
+        // rotation offset Rivest removes per window.
+        let n = 9000;
+        let time_s: Vec<f64> = (0..n).map(|i| i as f64 / 50.0).collect();
+        let measured: Vec<Quat> = time_s
+            .iter()
+            .map(|&t| {
+                let flex = 45.0 - 30.0 * (t * 0.5).cos();
+                let off = if t < 90.0 { 8.0 } else { 12.0 };
+                quat_from_euler_zyx_deg([0.0, flex, 0.0])
+                    * quat_axis_angle_deg([1.0, 0.0, 0.0], off)
+            })
+            .collect();
+        let windows = layout(&time_s, 60.0, 30.0);
+        let sol = solve_joint(Method::Rivest, &time_s, &measured, &windows);
+        let BaselineRecord::Rivest { fits } = &sol.record else {
+            panic!("rivest record")
+        };
+        assert_eq!(fits.len(), windows.len());
+        assert!((fits[0].b2 - 8.0).abs() < 1e-6 && (fits.last().unwrap().b2 - 12.0).abs() < 1e-6);
+        for i in [0, 1000, 8999] {
+            let c = euler_zyx_deg(&(measured[i] * sol.series[i]));
+            assert!(c[0].abs() < 1e-6 && c[2].abs() < 1e-6, "{i}: {c:?}");
+            assert!((c[1] - euler_zyx_deg(&measured[i])[1]).abs() < 1e-9);
+        }
+        // Half-way between the centres of windows 2 and 3 (at 75 s and 105 s).
+        let mid = fits[2].lerp(&fits[3], 0.5);
+        assert!((mid.b2 - 0.5 * (fits[2].b2 + fits[3].b2)).abs() < 1e-12);
+        let one = solve_joint(Method::Rivest, &time_s, &measured, &whole_trial(&time_s));
+        assert_eq!(one.windows.len(), 1);
+    }
+}

@@ -1,0 +1,455 @@
+//! A trial made of Xsens exports (one file per sensor), aligned on the packet counter.
+//!
+//! A trial is named by its mapping XML ([`super::mapping`]) or by a folder of
+//! exports. The mapping's exports are looked for beside the XML, then in its
+//! immediate subfolders (OpenSense's example keeps them in `IMUData/`). A folder
+//! uses a mapping XML inside it, else one in its parent folder whose exports it
+//! holds, else names each sensor by its serial (the file name after its last `_`).
+//!
+//! Sensors are aligned on the unwrapped packet counter: only packets every
+//! sensor recorded are kept (as OpenSense does), time is
+//! `(counter - first kept counter) / rate` in seconds, and packets a sensor
+//! lacks become gaps in the time vector, each one reported.
+
+use super::mapping::{looks_like_mapping, parse_mapping, sensor_to_opensim, Mapping};
+use super::xsens::{parse_export, XsensExport, COUNTER_MODULUS};
+use super::{ImuSeries, Trial, TrialError};
+use crate::model::Model;
+use crate::rotation::Quat;
+use std::path::{Path, PathBuf};
+
+/// The files of an Xsens trial and the names of their sensors.
+#[derive(Debug, Clone)]
+pub struct XsensSource {
+    /// The mapping used, with its path.
+    pub mapping: Option<(PathBuf, Mapping)>,
+    /// Export files with the IMU name each stands for (as found, before aliases).
+    pub files: Vec<(PathBuf, String)>,
+}
+
+fn read_text(path: &Path) -> Result<String, TrialError> {
+    std::fs::read_to_string(path)
+        .map_err(|e| TrialError::file(path.display().to_string(), format!("cannot read: {e}")))
+}
+
+/// True when `path` is an XML file holding an OpenSense Xsens mapping.
+pub fn is_mapping_file(path: &Path) -> bool {
+    let xml = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+    xml && path.is_file() && head(path, 1 << 16).is_some_and(|t| looks_like_mapping(&t))
+}
+
+/// The first `limit` bytes of a file as text (lossy), if it can be read.
+fn head(path: &Path, limit: u64) -> Option<String> {
+    use std::io::Read;
+    let mut buf = Vec::new();
+    std::fs::File::open(path)
+        .ok()?
+        .take(limit)
+        .read_to_end(&mut buf)
+        .ok()?;
+    Some(String::from_utf8_lossy(&buf).into_owned())
+}
+
+/// True when `path` is a `.txt` file that starts like an MT Manager export
+/// (a `//` comment or a header with `PacketCounter`).
+pub fn is_export_file(path: &Path) -> bool {
+    let txt = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("txt"));
+    txt && path.is_file()
+        && head(path, 4096).is_some_and(|t| {
+            let first = t.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+            first.starts_with("//") || first.contains("PacketCounter")
+        })
+}
+
+fn sorted_entries(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|rd| rd.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// True when `dir` is a folder holding at least one Xsens export.
+pub fn is_export_folder(dir: &Path) -> bool {
+    dir.is_dir() && sorted_entries(dir).iter().any(|p| is_export_file(p))
+}
+
+/// The folders a mapping at `xml` reads its exports from: where its first
+/// sensor's export is, beside the XML or in an immediate subfolder.
+fn export_folder(xml: &Path, mapping: &Mapping) -> Option<PathBuf> {
+    let dir = xml.parent().unwrap_or(Path::new("."));
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let first = format!(
+        "{}{}.txt",
+        mapping.trial_prefix, mapping.sensors[0].file_suffix
+    );
+    std::iter::once(dir.to_path_buf())
+        .chain(sorted_entries(dir).into_iter().filter(|p| p.is_dir()))
+        .find(|d| d.join(&first).is_file())
+}
+
+fn files_of_mapping(
+    xml: &Path,
+    mapping: &Mapping,
+    folder: &Path,
+) -> Result<Vec<(PathBuf, String)>, TrialError> {
+    mapping
+        .sensors
+        .iter()
+        .map(|s| {
+            let f = folder.join(format!("{}{}.txt", mapping.trial_prefix, s.file_suffix));
+            if f.is_file() {
+                Ok((f, s.name_in_model.clone()))
+            } else {
+                Err(TrialError::at(
+                    xml.display().to_string(),
+                    s.line,
+                    1,
+                    format!(
+                        "sensor '{}' ({}): expected its export {} (trial_prefix + name + .txt)",
+                        s.file_suffix,
+                        s.name_in_model,
+                        f.display()
+                    ),
+                ))
+            }
+        })
+        .collect()
+}
+
+/// Reads the mapping at `xml` and finds its exports.
+fn resolve_mapping(xml: &Path) -> Result<XsensSource, TrialError> {
+    let origin = xml.display().to_string();
+    let mapping = parse_mapping(&read_text(xml)?, &origin)?;
+    let folder = export_folder(xml, &mapping).ok_or_else(|| {
+        let s = &mapping.sensors[0];
+        TrialError::at(
+            &origin,
+            s.line,
+            1,
+            format!(
+                "expected the export {}{}.txt beside the mapping or in a folder next to it",
+                mapping.trial_prefix, s.file_suffix
+            ),
+        )
+    })?;
+    let files = files_of_mapping(xml, &mapping, &folder)?;
+    Ok(XsensSource {
+        mapping: Some((xml.to_path_buf(), mapping)),
+        files,
+    })
+}
+
+/// A mapping (in `dir` or its parent) whose exports are in `dir`.
+fn mapping_for_folder(dir: &Path) -> Option<PathBuf> {
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+    let candidates = sorted_entries(dir)
+        .into_iter()
+        .chain(parent.map(sorted_entries).unwrap_or_default());
+    for xml in candidates.filter(|p| is_mapping_file(p)) {
+        let Ok(text) = std::fs::read_to_string(&xml) else {
+            continue;
+        };
+        let Ok(m) = parse_mapping(&text, "") else {
+            continue;
+        };
+        let first = format!("{}{}.txt", m.trial_prefix, m.sensors[0].file_suffix);
+        if dir.join(first).is_file() {
+            return Some(xml);
+        }
+    }
+    None
+}
+
+/// Resolves an Xsens trial path: a mapping XML or a folder of exports.
+pub fn resolve(path: &Path) -> Result<XsensSource, TrialError> {
+    if !path.is_dir() {
+        return resolve_mapping(path);
+    }
+    if let Some(xml) = mapping_for_folder(path) {
+        let mut source = resolve_mapping(&xml)?;
+        let inside = source.files.iter().all(|(f, _)| f.parent() == Some(path));
+        if inside {
+            return Ok(source);
+        }
+        source.files.retain(|(f, _)| f.parent() == Some(path));
+    }
+    let files: Vec<(PathBuf, String)> = sorted_entries(path)
+        .into_iter()
+        .filter(|p| is_export_file(p))
+        .map(|p| {
+            let stem = p
+                .file_stem()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned();
+            let serial = stem.rsplit('_').next().unwrap_or(&stem).to_string();
+            (p, serial)
+        })
+        .collect();
+    if files.is_empty() {
+        return Err(TrialError::file(
+            path.display().to_string(),
+            "no Xsens exports: expected MT Manager .txt exports (// comments, a header with PacketCounter) in this folder",
+        ));
+    }
+    Ok(XsensSource {
+        mapping: None,
+        files,
+    })
+}
+
+/// The IMU names of an Xsens trial, as found (before aliases), without reading the data.
+pub fn imu_names(path: &Path) -> Result<Vec<String>, TrialError> {
+    Ok(resolve(path)?.files.into_iter().map(|(_, n)| n).collect())
+}
+
+/// The bytes that identify the trial's input (mapping, then every export in order),
+/// for the sidecar's hash.
+pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
+    let source = resolve(path).map_err(|e| std::io::Error::other(e.to_string()))?;
+    let mut out = Vec::new();
+    if let Some((xml, _)) = &source.mapping {
+        out.extend(std::fs::read(xml)?);
+    }
+    for (f, _) in &source.files {
+        out.extend(std::fs::read(f)?);
+    }
+    Ok(out)
+}
+
+/// Reads an Xsens trial (mapping XML or folder): exports parsed, aligned on the
+/// packet counter, rotated by the mapping's `sensor_to_opensim_rotations` if any,
+/// IMU names mapped through `model`'s aliases. `Trial::name` is the path's last component.
+pub fn read_xsens_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
+    let source = resolve(path)?;
+    let mut exports = Vec::with_capacity(source.files.len());
+    for (f, name) in &source.files {
+        let origin = f.display().to_string();
+        exports.push((name.clone(), parse_export(&read_text(f)?, &origin)?));
+    }
+    let rotation = source
+        .mapping
+        .as_ref()
+        .and_then(|(_, m)| m.sensor_to_opensim_rad)
+        .map(sensor_to_opensim);
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string());
+    assemble(&name, exports, rotation, model)
+}
+
+/// Counters shifted by whole wraps so that every file starts within half a
+/// wrap of the first file's start (files of one recording start together).
+fn align_wraps(exports: &mut [(String, XsensExport)]) {
+    let Some(reference) = exports.first().map(|(_, e)| e.counters[0] as i128) else {
+        return;
+    };
+    let m = COUNTER_MODULUS as i128;
+    let shifts: Vec<i128> = exports
+        .iter()
+        .map(|(_, e)| ((reference - e.counters[0] as i128) as f64 / m as f64).round() as i128 * m)
+        .collect();
+    let lowest = shifts.iter().copied().min().unwrap_or(0);
+    for ((_, e), s) in exports.iter_mut().zip(shifts) {
+        let s = (s - lowest) as u64;
+        e.counters.iter_mut().for_each(|c| *c += s);
+    }
+}
+
+fn common_rate(exports: &[(String, XsensExport)]) -> Result<f64, TrialError> {
+    let mut rate: Option<(f64, &str)> = None;
+    for (_, e) in exports {
+        if let Some(r) = e.rate_hz {
+            match rate {
+                None => rate = Some((r, &e.origin)),
+                Some((r0, o0)) if (r - r0).abs() > 1e-9 * r0 => {
+                    return Err(TrialError::at(
+                        &e.origin,
+                        1,
+                        1,
+                        format!("update rate {r} Hz differs from {r0} Hz of {o0}; expected one rate for all sensors"),
+                    ))
+                }
+                _ => {}
+            }
+        }
+    }
+    rate.map(|(r, _)| r).ok_or_else(|| {
+        TrialError::at(
+            &exports[0].1.origin,
+            1,
+            1,
+            "no update rate: expected a comment line '// Update Rate: <Hz>' in at least one export",
+        )
+    })
+}
+
+/// Runs of counters missing inside a file, as `(first missing, count)`.
+fn missing_runs(counters: &[u64]) -> Vec<(u64, u64)> {
+    counters
+        .windows(2)
+        .filter(|w| w[1] > w[0] + 1)
+        .map(|w| (w[0] + 1, w[1] - w[0] - 1))
+        .collect()
+}
+
+/// Aligns parsed exports into one trial.
+pub(crate) fn assemble(
+    name: &str,
+    mut exports: Vec<(String, XsensExport)>,
+    rotation: Option<Quat>,
+    model: &Model,
+) -> Result<Trial, TrialError> {
+    let rate = common_rate(&exports)?;
+    align_wraps(&mut exports);
+    let start = exports
+        .iter()
+        .map(|(_, e)| e.counters[0])
+        .max()
+        .unwrap_or(0);
+    let end = exports
+        .iter()
+        .map(|(_, e)| *e.counters.last().unwrap_or(&0))
+        .min()
+        .unwrap_or(0);
+    if start > end {
+        return Err(TrialError::file(
+            exports[0].1.origin.clone(),
+            format!("the sensors share no packet: their counters cover {start} and {end} apart; expected exports of one recording"),
+        ));
+    }
+    let mut warnings = Vec::new();
+    // Indices, per file, of the packets every file has.
+    let mut pos = vec![0usize; exports.len()];
+    let mut kept: Vec<(u64, Vec<usize>)> = Vec::new();
+    for &c in exports[0]
+        .1
+        .counters
+        .iter()
+        .filter(|&&c| c >= start && c <= end)
+    {
+        let mut idx = Vec::with_capacity(exports.len());
+        for (k, (_, e)) in exports.iter().enumerate() {
+            while pos[k] < e.counters.len() && e.counters[pos[k]] < c {
+                pos[k] += 1;
+            }
+            if pos[k] < e.counters.len() && e.counters[pos[k]] == c {
+                idx.push(pos[k]);
+            }
+        }
+        if idx.len() == exports.len() {
+            kept.push((c, idx));
+        }
+    }
+    let firsts: Vec<u64> = exports.iter().map(|(_, e)| e.counters[0]).collect();
+    let lasts: Vec<u64> = exports
+        .iter()
+        .map(|(_, e)| *e.counters.last().unwrap_or(&0))
+        .collect();
+    let spread = |v: &[u64]| v.iter().max() != v.iter().min();
+    let range = |v: &[u64]| {
+        let (lo, hi) = (v.iter().min().unwrap_or(&0), v.iter().max().unwrap_or(&0));
+        if lo == hi {
+            format!("{lo}")
+        } else {
+            format!("{lo}..{hi}")
+        }
+    };
+    if spread(&firsts) || spread(&lasts) {
+        warnings.push(format!(
+            "sensors start at packet {} and end at packet {}: kept packets {start}..{end} ({} samples), which every sensor recorded",
+            range(&firsts),
+            range(&lasts),
+            kept.len()
+        ));
+    }
+    for (imu, e) in &exports {
+        let inside: Vec<u64> = e
+            .counters
+            .iter()
+            .copied()
+            .filter(|&c| c >= start && c <= end)
+            .collect();
+        let runs = missing_runs(&inside);
+        if !runs.is_empty() {
+            let total: u64 = runs.iter().map(|r| r.1).sum();
+            let list: Vec<String> = runs
+                .iter()
+                .take(3)
+                .map(|(c, n)| format!("{n} from packet {c}"))
+                .collect();
+            let more = if runs.len() > 3 { ", ..." } else { "" };
+            warnings.push(format!(
+                "{imu} ({}): {total} packets missing ({}{more}); those samples are left out of every sensor (gaps)",
+                file_name(&e.origin),
+                list.join(", ")
+            ));
+        }
+    }
+    let mut imus: Vec<ImuSeries> = Vec::with_capacity(exports.len());
+    for (k, (found, e)) in exports.iter().enumerate() {
+        let canonical = match model.canonical_imu(found) {
+            Some(c) => c.to_string(),
+            None => {
+                warnings.push(format!(
+                    "IMU '{found}' ({}) is not in model {} and will be ignored",
+                    file_name(&e.origin),
+                    model.name
+                ));
+                found.clone()
+            }
+        };
+        if let Some(prev) = imus.iter().position(|s| s.name == canonical) {
+            return Err(TrialError::file(
+                e.origin.clone(),
+                format!(
+                    "repeated IMU: '{found}' is '{canonical}', as is {}; expected each IMU once",
+                    file_name(&exports[prev].1.origin)
+                ),
+            ));
+        }
+        if e.renormalised > 0 {
+            warnings.push(format!(
+                "{canonical}: renormalised {} quaternions that were off unit norm by more than 1e-4",
+                e.renormalised
+            ));
+        }
+        let orientation = kept
+            .iter()
+            .map(|(_, idx)| {
+                let q = e.orientation[idx[k]];
+                rotation.map_or(q, |r| r * q)
+            })
+            .collect();
+        imus.push(ImuSeries {
+            name: canonical,
+            orientation,
+        });
+    }
+    Ok(Trial {
+        name: name.to_string(),
+        time_s: kept
+            .iter()
+            .map(|(c, _)| (c - start) as f64 / rate)
+            .collect(),
+        imus,
+        warnings,
+    })
+}
+
+fn file_name(origin: &str) -> String {
+    Path::new(origin)
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| origin.to_string())
+}

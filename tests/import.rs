@@ -1,0 +1,340 @@
+//! Real recordings as labs have them, in files this test makes in the same
+//! shapes as the public examples: Xsens MT Manager exports (one per sensor, with
+//! matrix, quaternion or Euler columns, packet counters that start apart and
+//! wrap), an OpenSense mapping XML, and a qmt-style wide CSV.
+//! Every read is compared with the orientations written (1e-9 per quaternion
+//! component, up to sign: the files carry Rust's shortest round-trip decimals, so
+//! only the matrix-to-quaternion conversion rounds) or with a located error.
+
+use acm_workbench::model::Model;
+use acm_workbench::rotation::{euler_zyx_deg, quat_from_euler_zyx_deg, Quat};
+use acm_workbench::trial::mapping::sensor_to_opensim;
+use acm_workbench::trial::{detect_format, detect_model, is_trial_path, read_trial, TrialFormat};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::fmt::Write as _;
+use std::path::Path;
+
+#[derive(Clone, Copy)]
+enum Columns {
+    Matrix,
+    Quaternion,
+    Euler,
+}
+
+/// Random orientations, pitch within +-80 deg (Euler columns stay regular).
+fn orientations(n: usize, seed: u64) -> Vec<Quat> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            quat_from_euler_zyx_deg([
+                rng.random_range(-179.0..179.0),
+                rng.random_range(-80.0..80.0),
+                rng.random_range(-179.0..179.0),
+            ])
+        })
+        .collect()
+}
+
+/// An MT Manager export: comments, the real files' header columns, and one
+/// row per (raw 16-bit) packet counter.
+fn export(counters: &[u64], qs: &[Quat], columns: Columns) -> String {
+    let mut out = String::from(
+        "// Start Time: Unknown\n// Update Rate: 100.0Hz\n// Filter Profile: human (46.1)\n// Option Flags: AHS Disabled ICC Disabled \n// Firmware Version: 4.0.2\n",
+    );
+    out.push_str("PacketCounter\tSampleTimeFine\tYear\tAcc_X\tAcc_Y\tAcc_Z");
+    match columns {
+        Columns::Matrix => {
+            for j in 1..=3 {
+                for i in 1..=3 {
+                    let _ = write!(out, "\tMat[{i}][{j}]");
+                }
+            }
+        }
+        Columns::Quaternion => out.push_str("\tQuat_q0\tQuat_q1\tQuat_q2\tQuat_q3"),
+        Columns::Euler => out.push_str("\tRoll\tPitch\tYaw"),
+    }
+    out.push('\n');
+    for (c, q) in counters.iter().zip(qs) {
+        let _ = write!(out, "{:05}\t\t\t0.1\t4.8\t-8.5", c % 65536);
+        match columns {
+            Columns::Matrix => {
+                let m = q.to_rotation_matrix().into_inner();
+                for j in 0..3 {
+                    for i in 0..3 {
+                        let _ = write!(out, "\t{}", m[(i, j)]);
+                    }
+                }
+            }
+            Columns::Quaternion => {
+                let _ = write!(out, "\t{}\t{}\t{}\t{}", q.w, q.i, q.j, q.k);
+            }
+            Columns::Euler => {
+                let [r, p, y] = euler_zyx_deg(q);
+                let _ = write!(out, "\t{r}\t{p}\t{y}");
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
+fn mapping_xml(prefix: &str, sensors: &[(&str, &str)], rotation: Option<&str>) -> String {
+    let mut out = format!(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n<OpenSimDocument Version=\"40000\">\n\t<XsensDataReaderSettings>\n\t\t<trial_prefix>{prefix}</trial_prefix>\n\t\t<ExperimentalSensors>\n"
+    );
+    for (serial, name) in sensors {
+        let _ = write!(
+            out,
+            "\t\t\t<ExperimentalSensor name=\"_{serial}\">\n\t\t\t\t<name_in_model>{name}</name_in_model>\n\t\t\t</ExperimentalSensor>\n"
+        );
+    }
+    out.push_str("\t\t</ExperimentalSensors>\n\t</XsensDataReaderSettings>\n");
+    if let Some(r) = rotation {
+        let _ = writeln!(
+            out,
+            "\t<sensor_to_opensim_rotations>{r}</sensor_to_opensim_rotations>"
+        );
+    }
+    out.push_str("</OpenSimDocument>\n");
+    out
+}
+
+fn assert_quat_eq(a: &Quat, b: &Quat, what: &str) {
+    let (a, b) = (a.into_inner(), b.into_inner());
+    let d = (a - b).norm().min((a + b).norm());
+    assert!(d < 1e-9, "{what}: {a:?} vs {b:?} ({d:e})");
+}
+
+/// One sensor: its serial, model name, column kind, raw counters and orientations.
+struct Sensor {
+    serial: &'static str,
+    name: &'static str,
+    columns: Columns,
+    counters: Vec<u64>,
+    qs: Vec<Quat>,
+}
+
+/// Three sensors of one recording whose counters cross the 16-bit wrap: they
+/// start apart (65530, 65528, 65533), end apart, and the tibia misses packets
+/// 65540..65542 (unwrapped), i.e. raw 4..6.
+fn sensors() -> Vec<Sensor> {
+    let make = |serial, name, columns, first: u64, last: u64, skip: &[u64], seed| {
+        let counters: Vec<u64> = (first..=last).filter(|c| !skip.contains(c)).collect();
+        let qs = orientations(counters.len(), seed);
+        Sensor {
+            serial,
+            name,
+            columns,
+            counters,
+            qs,
+        }
+    };
+    vec![
+        make(
+            "00B42279",
+            "pelvis_imu",
+            Columns::Matrix,
+            65530,
+            65560,
+            &[],
+            1,
+        ),
+        make(
+            "00B4227C",
+            "femur_r_imu",
+            Columns::Quaternion,
+            65528,
+            65570,
+            &[],
+            2,
+        ),
+        make(
+            "00B4227D",
+            "tibia_r_imu",
+            Columns::Euler,
+            65533,
+            65565,
+            &[65540, 65541, 65542],
+            3,
+        ),
+    ]
+}
+
+fn write_recording(dir: &Path, sub: &str, sensors: &[Sensor], rotation: Option<&str>) {
+    let data = dir.join(sub);
+    std::fs::create_dir_all(&data).unwrap();
+    for s in sensors {
+        let f = data.join(format!("MT_TEST-001_{}.txt", s.serial));
+        std::fs::write(f, export(&s.counters, &s.qs, s.columns)).unwrap();
+    }
+    let pairs: Vec<(&str, &str)> = sensors.iter().map(|s| (s.serial, s.name)).collect();
+    std::fs::write(
+        dir.join("myIMUMappings.xml"),
+        mapping_xml("MT_TEST-001", &pairs, rotation),
+    )
+    .unwrap();
+}
+
+#[test]
+fn xsens_exports_align_on_wrapped_counters_through_the_mapping() {
+    let dir = tempfile::tempdir().unwrap();
+    let sensors = sensors();
+    let rx = -std::f64::consts::FRAC_PI_2;
+    write_recording(
+        dir.path(),
+        "IMUData",
+        &sensors,
+        Some(&format!("{rx} 0 0.25")),
+    );
+    let xml = dir.path().join("myIMUMappings.xml");
+    assert!(is_trial_path(&xml) && is_trial_path(&dir.path().join("IMUData")));
+    assert_eq!(detect_format(&xml).unwrap(), (TrialFormat::Xsens, false));
+    let model = detect_model(&xml);
+    assert_eq!(model.name, "opensense_lower");
+    let trial = read_trial(&xml, &model).unwrap();
+    // Every sensor has 65533..=65560 except the tibia's 65540..=65542.
+    let kept: Vec<u64> = (65533..=65560)
+        .filter(|c| !(65540..=65542).contains(c))
+        .collect();
+    let times: Vec<f64> = kept.iter().map(|c| (c - 65533) as f64 / 100.0).collect();
+    assert_eq!(trial.time_s, times);
+    let r = sensor_to_opensim([rx, 0.0, 0.25]);
+    for s in &sensors {
+        let series = trial.imu(s.name).unwrap();
+        for (k, c) in kept.iter().enumerate() {
+            let i = s.counters.iter().position(|x| x == c).unwrap();
+            assert_quat_eq(
+                &series.orientation[k],
+                &(r * s.qs[i]),
+                &format!("{} packet {c}", s.name),
+            );
+        }
+    }
+    let w = trial.warnings.join("\n");
+    assert!(
+        w.contains("start at packet 65528..65533 and end at packet 65560..65570")
+            && w.contains("kept packets 65533..65560 (25 samples)"),
+        "{w}"
+    );
+    assert!(w.contains("3 packets missing (3 from packet 65540)"), "{w}");
+    assert_eq!(trial.warnings.len(), 2, "{w}");
+
+    // The folder reads the same through the mapping in its parent.
+    let folder = read_trial(&dir.path().join("IMUData"), &model).unwrap();
+    assert_eq!(folder.time_s, trial.time_s);
+    assert_eq!(folder.imus, trial.imus);
+}
+
+#[test]
+fn folder_without_mapping_names_sensors_by_serial() {
+    let dir = tempfile::tempdir().unwrap();
+    let sensors = sensors();
+    write_recording(dir.path(), "data", &sensors, None);
+    std::fs::remove_file(dir.path().join("myIMUMappings.xml")).unwrap();
+    let model = Model::builtin("opensense_lower").unwrap();
+    let trial = read_trial(&dir.path().join("data"), &model).unwrap();
+    let names: Vec<&str> = trial.imus.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["00B42279", "00B4227C", "00B4227D"]);
+    // No rotation without a mapping: the Xsens frame as exported.
+    let i = sensors[0]
+        .counters
+        .iter()
+        .position(|&c| c == 65533)
+        .unwrap();
+    assert_quat_eq(&trial.imus[0].orientation[0], &sensors[0].qs[i], "pelvis");
+    assert!(trial
+        .warnings
+        .iter()
+        .any(|w| w.contains("'00B42279'") && w.contains("not in model")));
+}
+
+#[test]
+fn xsens_errors_name_file_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let sensors = sensors();
+    write_recording(dir.path(), "IMUData", &sensors, None);
+    let model = Model::builtin("opensense_lower").unwrap();
+    let xml = dir.path().join("myIMUMappings.xml");
+    // A bad cell: the quaternion's x of the femur's 3rd sample (line 6 + 3 = 9, column 8).
+    let femur = dir.path().join("IMUData/MT_TEST-001_00B4227C.txt");
+    let text = std::fs::read_to_string(&femur).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut cells: Vec<&str> = lines[8].split('\t').collect();
+    cells[7] = "0.5x";
+    lines[8] = cells.join("\t");
+    std::fs::write(&femur, lines.join("\n")).unwrap();
+    let e = read_trial(&xml, &model).unwrap_err();
+    assert_eq!(e.file, femur.display().to_string());
+    assert_eq!((e.line, e.column), (9, 8), "{e}");
+    assert!(e.message.contains("Quat_q1"), "{e}");
+    // A mapping naming a sensor without an export: the sensor's line in the XML.
+    let pairs = [("00B42279", "pelvis_imu"), ("00B4FFFF", "torso_imu")];
+    std::fs::write(&xml, mapping_xml("MT_TEST-001", &pairs, None)).unwrap();
+    let e = read_trial(&xml, &model).unwrap_err();
+    assert_eq!((e.file.as_str(), e.line), (xml.to_str().unwrap(), 9), "{e}");
+    assert!(e.message.contains("MT_TEST-001_00B4FFFF.txt"), "{e}");
+}
+
+#[test]
+fn wide_csv_with_time_s_reads_with_the_16_segment_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let segments = [
+        "foot_left",
+        "lower_leg_left",
+        "upper_leg_left",
+        "foot_right",
+        "lower_leg_right",
+        "upper_leg_right",
+        "hip",
+        "lower_back",
+        "upper_back",
+        "head",
+        "hand_left",
+        "forearm_left",
+        "upper_arm_left",
+        "hand_right",
+        "forearm_right",
+        "upper_arm_right",
+    ];
+    let n = 20;
+    let qs: Vec<Vec<Quat>> = (0..segments.len())
+        .map(|k| orientations(n, 10 + k as u64))
+        .collect();
+    let mut text = String::from("time_s");
+    for s in segments {
+        let _ = write!(text, ",{s}_qw,{s}_qx,{s}_qy,{s}_qz");
+    }
+    text.push('\n');
+    for i in 0..n {
+        let _ = write!(text, "{:.2}", i as f64 * 0.01);
+        for q in &qs {
+            let q = q[i];
+            let _ = write!(text, ",{},{},{},{}", q.w, q.i, q.j, q.k);
+        }
+        text.push('\n');
+    }
+    let path = dir.path().join("full_body_quat_wxyz_100Hz.csv");
+    std::fs::write(&path, text).unwrap();
+    let model = detect_model(&path);
+    assert_eq!(model.name, "full_body16");
+    let trial = read_trial(&path, &model).unwrap();
+    assert!(trial.warnings.is_empty(), "{:?}", trial.warnings);
+    assert_eq!(trial.imus.len(), 16);
+    assert_quat_eq(
+        &trial.imu("l_hand").unwrap().orientation[7],
+        &qs[10][7],
+        "hand_left",
+    );
+    assert_quat_eq(
+        &trial.imu("pelvis").unwrap().orientation[3],
+        &qs[6][3],
+        "hip",
+    );
+    // Every joint of the model, wrists and both back joints included, is covered
+    // by the shipped default table.
+    let table = acm_workbench::limits::LimitTable::default_table();
+    table.check_covers(&model, "table_3_2.csv").unwrap();
+    let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    assert!(names.contains(&"l_wrist") && names.contains(&"lumbar") && names.contains(&"thoracic"));
+}
