@@ -218,10 +218,10 @@ mod tests {
         // Without the base, the first segment present starts at the origin.
         let q: HashMap<&str, Quat> =
             [("l_thigh", Quat::identity()), ("l_calf", Quat::identity())].into();
-        let pose = s.pose(|imu| q.get(imu).copied());
-        assert!(close(pose[idx("l_thigh")].unwrap()[0], [0.0; 3]));
-        assert!(close(pose[idx("l_calf")].unwrap()[1], [-0.26, 0.0, 0.0]));
-        assert_eq!(pose.iter().filter(|p| p.is_some()).count(), 2);
+        let knee = s.pose(|imu| q.get(imu).copied());
+        assert!(close(knee[idx("l_thigh")].unwrap()[0], [0.0; 3]));
+        assert!(close(knee[idx("l_calf")].unwrap()[1], [-0.26, 0.0, 0.0]));
+        assert_eq!(knee.iter().filter(|p| p.is_some()).count(), 2);
         // The body frame turns with the base: forward is +Y.
         let f = BodyFrame::of(&pose);
         assert!(close(f.forward, [0.0, 1.0, 0.0]) && close(f.left, [-1.0, 0.0, 0.0]));
