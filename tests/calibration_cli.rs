@@ -204,3 +204,33 @@ fn trial_corrected_with_the_calibration_applied_first() {
     ));
     assert_eq!(std::fs::read(d.join("again.csv")).unwrap(), first);
 }
+
+#[test]
+fn sample_recording_matches_its_truth_and_calibrates() {
+    use acm_workbench::calibration::simulate::{load_truth_beside, simulate, CalibSimConfig};
+    use acm_workbench::calibration::{calibrate, Protocol, Recording};
+    use acm_workbench::rotation::angle_between_deg;
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("sample_trials/child_arms.calib.csv.gz");
+    let rec = Recording::read(&path).unwrap();
+    let truth = load_truth_beside(&path).unwrap().unwrap();
+    // The file is the simulator's output (from the truth's configuration)
+    // rounded to 3 decimals.
+    let config: CalibSimConfig = serde_json::from_str(
+        &std::fs::read_to_string(path.with_file_name("child_arms.calib.truth.json")).unwrap(),
+    )
+    .unwrap();
+    let p = Protocol::default_protocol();
+    let again = simulate(&p, &config).unwrap().recording;
+    assert_eq!(again.len(), rec.len());
+    for (a, b) in rec.imus.iter().zip(&again.imus) {
+        for (x, y) in a.gyro.iter().zip(&b.gyro) {
+            assert!((0..3).all(|k| (x[k] - y[k]).abs() <= 5e-4 + 1e-9));
+        }
+    }
+    let cal = calibrate(&rec, &p);
+    assert_eq!(cal.segments.len(), 5);
+    for s in &cal.segments {
+        let err = angle_between_deg(&s.rotation(), &truth[&s.imu]);
+        assert!(err < 2.0, "{}: {err}", s.imu);
+    }
+}

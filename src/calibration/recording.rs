@@ -244,6 +244,16 @@ impl Recording {
         Ok(rec)
     }
 
+    /// Rounds every reading to `decimals` decimals (a sensor's resolution).
+    pub fn round(&mut self, decimals: u32) {
+        let f = 10f64.powi(decimals.min(15) as i32);
+        let r = |v: &mut [f64; 3]| v.iter_mut().for_each(|x| *x = (*x * f).round() / f);
+        for i in &mut self.imus {
+            i.acc.iter_mut().for_each(r);
+            i.gyro.iter_mut().for_each(r);
+        }
+    }
+
     /// The recording as CSV text (the format [`Recording::parse`] reads).
     pub fn to_csv(&self) -> String {
         let mut out = String::from("time,label");

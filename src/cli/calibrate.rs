@@ -198,8 +198,16 @@ pub fn apply(
         return Ok(None);
     };
     let applied = AppliedCalibration::load(path)?;
-    for w in applied.apply(trial, model) {
-        if !quiet {
+    let warnings = applied.apply(trial, model);
+    if !quiet {
+        eprintln!(
+            "{}: calibration {} applied to {} of its {} IMUs first",
+            trial.name,
+            applied.file,
+            applied.imus.len() - warnings.len(),
+            applied.imus.len()
+        );
+        for w in warnings {
             eprintln!("warning: {w}");
         }
     }
@@ -232,6 +240,10 @@ pub struct SimulateCalibrationArgs {
     /// Accelerometer noise per axis, m/s^2 RMS.
     #[arg(long, default_value_t = 0.1)]
     pub acc_noise: f64,
+    /// Round the readings to this many decimals, as a sensor's resolution
+    /// [default: exact].
+    #[arg(long)]
+    pub decimals: Option<u32>,
     /// Output recording (`*.calib.csv`, optionally `.gz`); the truth goes beside
     /// it as `<stem>.truth.json`.
     #[arg(short, long)]
@@ -273,13 +285,16 @@ pub fn simulate_run(a: SimulateCalibrationArgs) -> anyhow::Result<i32> {
         overrides: a.sloppy.into_iter().collect(),
         ..defaults
     };
-    let sim = match simulate::simulate(&protocol, &config) {
+    let mut sim = match simulate::simulate(&protocol, &config) {
         Ok(s) => s,
         Err(e) => {
             eprintln!("acmw: {e}");
             return Ok(2);
         }
     };
+    if let Some(d) = a.decimals {
+        sim.recording.round(d);
+    }
     let text = sim.recording.to_csv();
     let bytes = if a
         .output

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Screen: trials, trial, compare, limits or help.
+    /// Screen: trials, trial, compare, limits, help or calibration.
     #[arg(value_parser = SCREENS)]
     pub screen: String,
     /// Folder of trials [default: ./sample_trials].

@@ -155,6 +155,7 @@ pub enum Screen {
     Limits,
     /// The analysis views (`super::views`).
     Views,
+    Calibration,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -411,6 +412,8 @@ pub struct App {
     pub quit: bool,
     /// State of the analysis views.
     pub views: super::views::ViewsState,
+    /// The calibration screen (`super::calibration`).
+    pub calib: super::calibration::CalibState,
 }
 
 /// What the runtime should do.
@@ -441,6 +444,8 @@ pub enum Effect {
         table_csv: String,
         settings_toml: String,
     },
+    /// Read and calibrate the calibration recordings of this folder.
+    Calibrations { dir: PathBuf },
     /// Ask for `Msg::RecorrectDue` after the debounce delay (a newer request
     /// replaces an older one).
     Debounce,
@@ -491,6 +496,8 @@ pub enum Msg {
     RecorrectDue,
     /// Time passes (only sent while something plays).
     Tick,
+    /// The calibration recordings of the folder, read and calibrated (protocol label).
+    Calibrations(Vec<super::calibration::CalibEntry>, String),
 }
 
 impl App {
@@ -518,6 +525,7 @@ impl App {
             message: None,
             quit: false,
             views: Default::default(),
+            calib: Default::default(),
         };
         for f in files {
             let path = app.dir.join(&f);
@@ -815,6 +823,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             super::views::tick(app);
             vec![]
         }
+        Msg::Calibrations(entries, protocol) => {
+            super::calibration::loaded(app, entries, protocol);
+            vec![]
+        }
     }
 }
 
@@ -1036,6 +1048,7 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
             super::views::action(app, a);
             vec![]
         }
+        Screen::Calibration => super::calibration::action(app, a),
     }
 }
 
@@ -1057,6 +1070,7 @@ fn trials_action(app: &mut App, a: Action) -> Vec<Effect> {
             app.sort_trials();
         }
         Action::Variant => next_variant(app),
+        Action::Calibration => return super::calibration::enter(app),
         Action::Enter | Action::Right => {
             let Some(e) = app.selected_entry() else {
                 return vec![];

@@ -15,8 +15,17 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The screens `acmw render` knows.
-pub const SCREENS: [&str; 9] = [
-    "trials", "trial", "compare", "limits", "help", "scatter", "globe", "applied", "stick",
+pub const SCREENS: [&str; 10] = [
+    "trials",
+    "trial",
+    "compare",
+    "limits",
+    "help",
+    "calibration",
+    "scatter",
+    "globe",
+    "applied",
+    "stick",
 ];
 
 /// A workbench over `dir` (shown as `dir_label`) with every trial read.
@@ -104,6 +113,10 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
         }
         "limits" => app.screen = Screen::Limits,
         "help" => app.overlay = Some(Overlay::Help),
+        "calibration" => {
+            let fx = super::calibration::enter(app);
+            SyncRunner::run(app, fx);
+        }
         _ => {}
     }
     Ok(())
@@ -224,5 +237,6 @@ pub fn write_demo_folder(dir: &Path) -> Result<(), String> {
         sim.truth.save_beside(&out).map_err(|e| e.to_string())?;
     }
     std::fs::write(dir.join("broken.csv"), "garbage,1,2\n").map_err(|e| e.to_string())?;
+    super::calibration::write_demo_recordings(dir)?;
     Ok(())
 }

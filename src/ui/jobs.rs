@@ -255,6 +255,7 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
             settings_toml,
         } => vec![save_limits(&dir, &table_name, &table_csv, &settings_toml)],
         Effect::Debounce => vec![Msg::RecorrectDue],
+        Effect::Calibrations { dir } => vec![super::calibration::scan(&dir)],
     }
 }
 

@@ -11,6 +11,7 @@
 
 pub mod app;
 pub mod applied;
+pub mod calibration;
 pub mod compare;
 pub mod globe;
 pub mod headless;

@@ -34,6 +34,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
         Screen::Compare => compare::render(app, theme, f, body),
         Screen::Limits => limits::render(app, theme, f, body),
         Screen::Views => views::render(app, theme, f, body),
+        Screen::Calibration => super::calibration::render(app, theme, f, body),
     }
     status_bar(app, theme, f, bottom);
     match &app.overlay {
@@ -55,6 +56,7 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             app.views.kind.name(),
             app.open.as_deref().unwrap_or("")
         ),
+        Screen::Calibration => "Calibration".to_string(),
     };
     let mut spans = vec![
         Span::styled(" acmw ", theme.title),
@@ -91,6 +93,7 @@ pub fn hints(app: &App) -> &'static str {
         Screen::Compare => "<- -> variant  Space choose  w save  r run  Esc back  ? help",
         Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
         Screen::Views => "x scatter  o globe  a applied  f stick  t time colour  Esc back  ? help",
+        Screen::Calibration => "Up/Down recording  r read again  Esc back  ? help  q quit",
     }
 }
 
