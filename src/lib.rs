@@ -11,6 +11,7 @@ pub mod calibration;
 pub mod limits;
 pub mod metrics;
 pub mod model;
+pub mod plot;
 pub mod report;
 pub mod rotation;
 pub mod save;

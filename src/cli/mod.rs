@@ -8,9 +8,12 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
+mod analysis;
 mod calibrate;
 mod common;
 mod correct;
+mod plot;
+mod plot_views;
 mod render;
 mod report;
 mod simulate;
@@ -51,6 +54,12 @@ pub enum Command {
     Simulate(simulate::SimulateArgs),
     /// Print a workbench screen as text (trials, trial, compare, limits, help).
     Render(render::RenderArgs),
+    /// Suggest a limit table from the 90% intervals of clean trials; prints the diff.
+    SuggestLimits(analysis::SuggestArgs),
+    /// Mean joint angles over the first 30 s of trials, as a centroid table.
+    Centroids(analysis::CentroidArgs),
+    /// Write a figure as SVG or PNG: traces or histogram.
+    Plot(plot::PlotArgs),
     /// Functional calibration of a recording (Ricci et al. 2014): rho table, residuals, calibration file.
     Calibrate(calibrate::CalibrateArgs),
 }
@@ -62,6 +71,9 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
         Some(Command::Render(a)) => render::run(a, &cli.theme),
+        Some(Command::SuggestLimits(a)) => analysis::run_suggest(a),
+        Some(Command::Centroids(a)) => analysis::run_centroids(a),
+        Some(Command::Plot(a)) => plot::run(a),
         Some(Command::Calibrate(a)) => calibrate::run(a),
         None => workbench(cli.dir, &cli.theme),
     };

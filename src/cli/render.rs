@@ -33,7 +33,7 @@ pub struct RenderArgs {
     pub color: bool,
 }
 
-fn parse_size(s: &str) -> Result<(u16, u16), String> {
+pub fn parse_size(s: &str) -> Result<(u16, u16), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WxH, found '{s}'"))?;

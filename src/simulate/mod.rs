@@ -32,6 +32,7 @@ use std::f64::consts::TAU;
 
 mod elbow;
 mod motion;
+pub mod swing;
 #[cfg(test)]
 mod tests;
 
@@ -48,11 +49,12 @@ pub const KNEE_IMUS: [&str; 2] = ["l_thigh", "l_calf"];
 /// Default random misalignment angles, degrees.
 pub const RANDOM_MISALIGNMENT_DEG: [f64; 2] = [5.0, 30.0];
 /// Names accepted by [`preset`].
-pub const PRESETS: [&str; 4] = [
+pub const PRESETS: [&str; 5] = [
     "knee_calf_z15",
     "full_body_clean",
     "full_body_drift",
     "elbow_20",
+    "full_body_swing",
 ];
 pub use elbow::{
     flexion_deg as elbow_flexion_deg, pronation_deg as elbow_pronation_deg, ELBOW_IMUS,
@@ -101,6 +103,9 @@ pub enum SimKind {
     /// (`simulate::elbow`). Each IMU is misaligned by `angle_deg` about a
     /// random axis perpendicular to its hinge axis (upper arm Z, forearm X).
     Elbow { angle_deg: f64 },
+    /// The 13 IMUs of `infant13`, every joint axis one sinusoid over a known
+    /// range (see [`swing`]): clean trials whose limits and centroids are known.
+    Swing,
 }
 
 /// Which IMU of the knee test is misaligned.
@@ -240,7 +245,7 @@ impl SimConfig {
     pub fn imus(&self, model: &Model) -> Vec<String> {
         match self.kind {
             SimKind::Knee { .. } => KNEE_IMUS.iter().map(|s| s.to_string()).collect(),
-            SimKind::FullBody => model.imus.clone(),
+            SimKind::FullBody | SimKind::Swing => model.imus.clone(),
             SimKind::Elbow { .. } => ELBOW_IMUS.iter().map(|s| s.to_string()).collect(),
         }
     }
@@ -332,7 +337,9 @@ impl SimConfig {
 /// random 5-30 degree misalignment, 0.3 degree noise, no drift), `full_body_drift`
 /// (as clean but 300 s, seed 2, heading drift on `l_calf` from 60 s at 0.05 deg/s
 /// and on `r_upper_arm` from 30 s at 0.08 deg/s), `elbow_20` (elbow test, both
-/// IMUs 20 degrees off their hinge axes, 5 min, 50 Hz, seed 3, 0.5 degree noise).
+/// IMUs 20 degrees off their hinge axes, 5 min, 50 Hz, seed 3, 0.5 degree noise),
+/// `full_body_swing` (13 IMUs, [`SimKind::Swing`], 60 s, 50 Hz, seed 1, no
+/// misalignment, 0.3 degree noise).
 pub fn preset(name: &str) -> Option<SimConfig> {
     match name {
         "knee_calf_z15" => Some(SimConfig::knee(KneeImu::Calf, KneeAxis::Z, 15.0)),
@@ -355,6 +362,12 @@ pub fn preset(name: &str) -> Option<SimConfig> {
                 },
             ],
             ..SimConfig::full_body(2)
+        }),
+        "full_body_swing" => Some(SimConfig {
+            kind: SimKind::Swing,
+            duration_s: 60.0,
+            misalignment: Misalignment::None,
+            ..SimConfig::full_body(1)
         }),
         _ => None,
     }
@@ -388,6 +401,7 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
         SimKind::Knee { .. } => knee_segments(&time_s),
         SimKind::FullBody => full_body_segments(&model, config.seed, &time_s),
         SimKind::Elbow { .. } => elbow::segments(&time_s),
+        SimKind::Swing => swing::segments(&model, config.seed, &time_s),
     };
 
     let misalignments = misalignments(config, &model, &segments);
@@ -459,6 +473,7 @@ fn kind_label(kind: &SimKind) -> String {
         SimKind::Knee { .. } => "simulated-knee".into(),
         SimKind::FullBody => "simulated-full-body".into(),
         SimKind::Elbow { .. } => "simulated-elbow".into(),
+        SimKind::Swing => "simulated-swing".into(),
     }
 }
 
@@ -488,17 +503,28 @@ fn full_body_segments(model: &Model, seed: u64, time_s: &[f64]) -> Vec<(String, 
         .iter()
         .map(|j| motion::joint_motion(&mut r, &table, j))
         .collect();
+    chain_segments(model, &base, time_s, |k, t| joints[k].angles_at(t))
+}
+
+/// Segment orientations of every IMU of `model`: the base from `base`, each
+/// joint's distal segment as its proximal one times `Rzyx(angles(joint index, t))`.
+fn chain_segments(
+    model: &Model,
+    base: &motion::BaseMotion,
+    time_s: &[f64],
+    angles: impl Fn(usize, f64) -> [f64; 3],
+) -> Vec<(String, Vec<Quat>)> {
     let mut by_imu: BTreeMap<&str, Vec<Quat>> = BTreeMap::new();
     by_imu.insert(
         &model.base,
         time_s.iter().map(|&t| base.orientation_at(t)).collect(),
     );
-    for (j, m) in model.joints.iter().zip(&joints) {
+    for (k, j) in model.joints.iter().enumerate() {
         let prox = &by_imu[j.proximal.as_str()];
         let dist = prox
             .iter()
             .zip(time_s)
-            .map(|(p, &t)| p * rotation::quat_from_euler_zyx_deg(m.angles_at(t)))
+            .map(|(p, &t)| p * rotation::quat_from_euler_zyx_deg(angles(k, t)))
             .collect();
         by_imu.insert(&j.distal, dist);
     }

@@ -24,7 +24,7 @@ const MAX_OVERSHOOT_DEG: f64 = 3.0;
 /// that the angles stay away from the Euler singularity at +-90 and come back
 /// unchanged when extracted from the rotation (the knee's 0..130 flexion range is
 /// simulated as 0..80).
-const MAX_ABS_Y_DEG: f64 = 80.0;
+pub(super) const MAX_ABS_Y_DEG: f64 = 80.0;
 
 /// One sinusoid `amp * sin(omega * t + phase)`.
 #[derive(Debug, Clone, Copy)]
