@@ -92,7 +92,21 @@ pub fn whole_trial(time_s: &[f64]) -> Vec<Window> {
 ///
 /// `centres_s` are relative to the first sample, like the windows.
 pub fn correction_series(time_s: &[f64], centres_s: &[f64], qs: &[Quat]) -> Vec<Quat> {
-    assert_eq!(centres_s.len(), qs.len());
+    between_centres(time_s, centres_s, qs, slerp)
+}
+
+/// Per-sample values from one value per window centre: the first before the
+/// first centre, the last from the last centre on, `mix(v_k, v_k+1, f)` between
+/// neighbouring centres with `f` the fraction of time elapsed (0..1).
+///
+/// `centres_s` are seconds from the first sample, like the windows.
+pub fn between_centres<T: Copy>(
+    time_s: &[f64],
+    centres_s: &[f64],
+    values: &[T],
+    mix: impl Fn(&T, &T, f64) -> T,
+) -> Vec<T> {
+    assert_eq!(centres_s.len(), values.len());
     let Some(&t0) = time_s.first() else {
         return Vec::new();
     };
@@ -102,16 +116,16 @@ pub fn correction_series(time_s: &[f64], centres_s: &[f64], qs: &[Quat]) -> Vec<
         .map(|&t| {
             let rel = t - t0;
             if rel < centres_s[0] {
-                return qs[0];
+                return values[0];
             }
             while k + 1 < centres_s.len() && rel >= centres_s[k + 1] {
                 k += 1;
             }
             if k + 1 == centres_s.len() {
-                return qs[k];
+                return values[k];
             }
             let f = (rel - centres_s[k]) / (centres_s[k + 1] - centres_s[k]);
-            slerp(&qs[k], &qs[k + 1], f)
+            mix(&values[k], &values[k + 1], f)
         })
         .collect()
 }

@@ -14,7 +14,7 @@
 pub mod mueller;
 pub mod rivest;
 
-use crate::acm::window::Window;
+use crate::acm::window::{between_centres, Window};
 use crate::acm::{Variant, WindowSolution};
 use crate::rotation::{angle_deg, canonical, euler_zyx_deg, quat_from_euler_zyx_deg, wxyz, Quat};
 use mueller::{estimate_axes, rates_from_orientations, MuellerFit, MuellerOptions};
@@ -99,7 +99,7 @@ fn solve_rivest(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> Baseli
         .map(|w| rivest::fit(&angles[w.first..w.end]))
         .collect();
     let centres: Vec<f64> = windows.iter().map(|w| w.centre_s).collect();
-    let per_sample = interpolate(time_s, &centres, &fits);
+    let per_sample = between_centres(time_s, &centres, &fits, RivestFit::lerp);
     let series: Vec<Quat> = measured
         .iter()
         .zip(&angles)
@@ -119,32 +119,6 @@ fn solve_rivest(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> Baseli
         series,
         record: BaselineRecord::Rivest { fits },
     }
-}
-
-/// Per-sample fits: the first before the first centre, the last after the last,
-/// linear between neighbouring centres (seconds from the first sample).
-fn interpolate(time_s: &[f64], centres_s: &[f64], fits: &[RivestFit]) -> Vec<RivestFit> {
-    let Some(&t0) = time_s.first() else {
-        return Vec::new();
-    };
-    let mut k = 0;
-    time_s
-        .iter()
-        .map(|&t| {
-            let rel = t - t0;
-            if rel < centres_s[0] {
-                return fits[0];
-            }
-            while k + 1 < centres_s.len() && rel >= centres_s[k + 1] {
-                k += 1;
-            }
-            if k + 1 == centres_s.len() {
-                return fits[k];
-            }
-            let f = (rel - centres_s[k]) / (centres_s[k + 1] - centres_s[k]);
-            fits[k].lerp(&fits[k + 1], f)
-        })
-        .collect()
 }
 
 fn solve_mueller(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> BaselineSolution {

@@ -58,3 +58,62 @@ pub(super) fn misalignments(seed: u64, angle_deg: f64) -> [(&'static str, Quat);
         ),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{simulate, SimConfig};
+    use super::*;
+    use crate::model::Model;
+    use crate::rotation::angle_deg;
+    use nalgebra::Vector3;
+
+    #[test]
+    fn elbow_truth_moves_in_flexion_and_pronation_only() {
+        let mut cfg = SimConfig::elbow(5, 20.0);
+        cfg.duration_s = 20.0;
+        let sim = simulate(&cfg).unwrap();
+        let names: Vec<&str> = sim.trial.imus.iter().map(|i| i.name.as_str()).collect();
+        assert_eq!(names, ELBOW_IMUS);
+        let model = Model::infant13();
+        let elbow = model.joint("l_elbow").unwrap();
+        assert_eq!(
+            (elbow.proximal.as_str(), elbow.distal.as_str()),
+            (ELBOW_IMUS[0], ELBOW_IMUS[1])
+        );
+        let angles = crate::metrics::joint_angles(&sim.truth.segments, elbow).unwrap();
+        let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+        for (a, &t) in angles.iter().zip(&sim.trial.time_s) {
+            assert!((a[0] - flexion_deg(t)).abs() < 1e-9 && a[1].abs() < 1e-9);
+            assert!((a[2] - pronation_deg(t)).abs() < 1e-9);
+            lo = lo.min(a[0]);
+            hi = hi.max(a[0]);
+        }
+        assert!(
+            lo > 15.0 && hi < 135.0 && hi - lo > 80.0,
+            "flexion {lo}..{hi}"
+        );
+        let upper = &sim.truth.segments.imu(ELBOW_IMUS[0]).unwrap().orientation;
+        assert!(upper.iter().all(|q| angle_deg(q) < 1e-12));
+    }
+
+    #[test]
+    fn elbow_misalignments_tilt_the_hinge_axes_by_the_full_angle() {
+        for seed in 0..20 {
+            let [(a, ma), (b, mb)] = misalignments(seed, 20.0);
+            assert_eq!([a, b], ELBOW_IMUS);
+            assert!((angle_deg(&ma) - 20.0).abs() < 1e-9 && (angle_deg(&mb) - 20.0).abs() < 1e-9);
+            // The rotation axis is perpendicular to the hinge axis, so the axis
+            // as the sensor sees it is tilted by the whole 20 degrees.
+            let tilt = |m: &Quat, axis: Vector3<f64>| {
+                (m.inverse() * axis)
+                    .dot(&axis)
+                    .clamp(-1.0, 1.0)
+                    .acos()
+                    .to_degrees()
+            };
+            assert!((tilt(&ma, Vector3::z()) - 20.0).abs() < 1e-9);
+            assert!((tilt(&mb, Vector3::x()) - 20.0).abs() < 1e-9);
+        }
+        assert_ne!(misalignments(1, 20.0)[0].1, misalignments(2, 20.0)[0].1);
+    }
+}

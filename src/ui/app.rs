@@ -156,6 +156,7 @@ pub enum Screen {
     /// The analysis views (`super::views`).
     Views,
     Calibration,
+    Histogram,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -414,6 +415,8 @@ pub struct App {
     pub views: super::views::ViewsState,
     /// The calibration screen (`super::calibration`).
     pub calib: super::calibration::CalibState,
+    /// The histogram screen, once opened.
+    pub histogram: Option<super::histogram::HistogramState>,
 }
 
 /// What the runtime should do.
@@ -446,6 +449,12 @@ pub enum Effect {
     },
     /// Read and calibrate the calibration recordings of this folder.
     Calibrations { dir: PathBuf },
+    /// Write a table (CSV text) atomically, never over `original`.
+    WriteTable {
+        path: PathBuf,
+        original: Option<PathBuf>,
+        csv: String,
+    },
     /// Ask for `Msg::RecorrectDue` after the debounce delay (a newer request
     /// replaces an older one).
     Debounce,
@@ -498,6 +507,8 @@ pub enum Msg {
     Tick,
     /// The calibration recordings of the folder, read and calibrated (protocol label).
     Calibrations(Vec<super::calibration::CalibEntry>, String),
+    /// A suggested limit table or a centroid table was written (its path), or why not.
+    TableWritten(Result<String, String>),
 }
 
 impl App {
@@ -526,6 +537,7 @@ impl App {
             quit: false,
             views: Default::default(),
             calib: Default::default(),
+            histogram: None,
         };
         for f in files {
             let path = app.dir.join(&f);
@@ -827,6 +839,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             super::calibration::loaded(app, entries, protocol);
             vec![]
         }
+        Msg::TableWritten(result) => {
+            super::histogram::written(app, result);
+            vec![]
+        }
     }
 }
 
@@ -1036,6 +1052,10 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
             app.screen = Screen::Limits;
             return vec![];
         }
+        Action::Histogram if matches!(app.screen, Screen::Trials | Screen::Trial) => {
+            app.message = None;
+            return super::histogram::open(app);
+        }
         _ => {}
     }
     app.message = None;
@@ -1049,6 +1069,7 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
             vec![]
         }
         Screen::Calibration => super::calibration::action(app, a),
+        Screen::Histogram => super::histogram::action(app, a),
     }
 }
 

@@ -15,13 +15,14 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The screens `acmw render` knows.
-pub const SCREENS: [&str; 10] = [
+pub const SCREENS: [&str; 11] = [
     "trials",
     "trial",
     "compare",
     "limits",
     "help",
     "calibration",
+    "histogram",
     "scatter",
     "globe",
     "applied",
@@ -116,6 +117,18 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
         "calibration" => {
             let fx = super::calibration::enter(app);
             SyncRunner::run(app, fx);
+        }
+        "histogram" => {
+            let t = trial.ok_or("no trial could be read")?;
+            open(app, t.clone());
+            super::histogram::open(app);
+            if let (Some(j), Some(st)) = (&s.joint, app.histogram.as_mut()) {
+                st.joint = st
+                    .hists
+                    .iter()
+                    .position(|h| h.name == *j)
+                    .ok_or_else(|| format!("no joint '{j}' in {t}"))?;
+            }
         }
         _ => {}
     }

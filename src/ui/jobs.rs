@@ -256,6 +256,15 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
         } => vec![save_limits(&dir, &table_name, &table_csv, &settings_toml)],
         Effect::Debounce => vec![Msg::RecorrectDue],
         Effect::Calibrations { dir } => vec![super::calibration::scan(&dir)],
+        Effect::WriteTable {
+            path,
+            original,
+            csv,
+        } => vec![super::histogram::write_job(
+            &path,
+            original.as_deref(),
+            &csv,
+        )],
     }
 }
 

@@ -15,6 +15,7 @@ pub mod calibration;
 pub mod compare;
 pub mod globe;
 pub mod headless;
+pub mod histogram;
 pub mod jobs;
 pub mod keymap;
 pub mod limits;

@@ -35,6 +35,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
         Screen::Limits => limits::render(app, theme, f, body),
         Screen::Views => views::render(app, theme, f, body),
         Screen::Calibration => super::calibration::render(app, theme, f, body),
+        Screen::Histogram => super::histogram::render(app, theme, f, body),
     }
     status_bar(app, theme, f, bottom);
     match &app.overlay {
@@ -57,6 +58,7 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             app.open.as_deref().unwrap_or("")
         ),
         Screen::Calibration => "Calibration".to_string(),
+        Screen::Histogram => "Histograms".to_string(),
     };
     let mut spans = vec![
         Span::styled(" acmw ", theme.title),
@@ -94,6 +96,9 @@ pub fn hints(app: &App) -> &'static str {
         Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
         Screen::Views => "x scatter  o globe  a applied  f stick  t time colour  Esc back  ? help",
         Screen::Calibration => "Up/Down recording  r read again  Esc back  ? help  q quit",
+        Screen::Histogram => {
+            "Enter suggest  w centroids  <- -> span  +- length  Home 30 s  End all  Esc back"
+        }
     }
 }
 

@@ -1,0 +1,542 @@
+//! The histogram screen (key `H` from the trials or trial screen): per joint
+//! and axis, the histogram of the chosen trials' angles over a span (the
+//! first 30 s unless moved), with the current limits, the mean and the
+//! interval holding 90% of the samples (thesis 3.1.2); Enter suggests a limit
+//! table from those intervals and shows its diff before saving it beside the
+//! current table; `w` saves the centroid table (thesis 3.3).
+//!
+//! The trials are the open one (from the trial screen) or every loaded trial
+//! the trials screen shows (filter with `/` first to choose).
+
+use super::app::{App, Effect, Msg, Screen};
+use super::keymap::Action;
+use super::render::{centred, fit, sel};
+use super::theme::Theme;
+use crate::analysis::centroid::centroids;
+use crate::analysis::histogram::{histograms, AxisHistogram, JointHistogram, DEFAULT_BIN_DEG};
+use crate::analysis::suggest::{same_file, suggest_limits, SuggestOptions, Suggestion, WriteError};
+use crate::analysis::{pool_by_joint, pool_by_table_row, TimeSpan, TrialRef};
+use crate::limits::axis_name;
+#[cfg(test)]
+use crate::limits::LimitTable;
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::symbols::Marker;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Axis, Block, Borders, Chart, Clear, Dataset, GraphType, Paragraph};
+use ratatui::Frame;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Shortest span the `-` key narrows to, seconds.
+const MIN_SPAN_S: f64 = 5.0;
+
+/// State of the histogram screen.
+#[derive(Debug, Clone)]
+pub struct HistogramState {
+    /// The screen Esc returns to.
+    pub from: Screen,
+    /// Trial files the histograms pool.
+    pub files: Vec<String>,
+    pub span: TimeSpan,
+    /// One per joint, in model order.
+    pub hists: Vec<JointHistogram>,
+    /// Selected joint (index into `hists`).
+    pub joint: usize,
+    /// A suggested table waiting for y (save) or n (cancel), and the diff's scroll.
+    pub suggestion: Option<Arc<Suggestion>>,
+    pub scroll: usize,
+}
+
+/// Opens the screen over the trials the current screen has chosen.
+pub fn open(app: &mut App) -> Vec<Effect> {
+    let files: Vec<String> = match app.screen {
+        Screen::Trial | Screen::Compare => app.open.clone().into_iter().collect(),
+        _ => app
+            .visible()
+            .into_iter()
+            .filter(|&i| app.trials[i].loaded().is_some())
+            .map(|i| app.trials[i].file.clone())
+            .collect(),
+    };
+    if files.is_empty() {
+        app.message = Some(("no loaded trial to take histograms of".into(), true));
+        return vec![];
+    }
+    let hists = compute(app, &files, TimeSpan::FIRST_30_S);
+    app.histogram = Some(HistogramState {
+        from: app.screen,
+        files,
+        span: TimeSpan::FIRST_30_S,
+        hists,
+        joint: 0,
+        suggestion: None,
+        scroll: 0,
+    });
+    app.screen = Screen::Histogram;
+    vec![]
+}
+
+/// The trials of `files` that are loaded, with their models.
+fn refs<'a>(app: &'a App, files: &[String]) -> Vec<TrialRef<'a>> {
+    files
+        .iter()
+        .filter_map(|f| app.entry(f)?.loaded())
+        .map(|l| TrialRef {
+            trial: &l.trial,
+            model: &l.model,
+        })
+        .collect()
+}
+
+/// Per-joint histograms of `files` over `span`, with the edited limits.
+pub fn compute(app: &App, files: &[String], span: TimeSpan) -> Vec<JointHistogram> {
+    let refs = refs(app, files);
+    let Some(model) = refs.first().map(|r| r.model) else {
+        return vec![];
+    };
+    let pooled = pool_by_joint(&refs, span);
+    histograms(&pooled, &app.limits.table, model, DEFAULT_BIN_DEG)
+}
+
+/// The suggested table's file: `<table stem>.suggested.csv` beside the table.
+pub fn suggested_path(app: &App) -> PathBuf {
+    let name = &app.limits.table_name;
+    let stem = name.strip_suffix(".csv").unwrap_or(name);
+    app.limits.dir.join(format!("{stem}.suggested.csv"))
+}
+
+/// The centroid table's file, beside the limit tables.
+pub fn centroids_path(app: &App) -> PathBuf {
+    app.limits.dir.join("centroids.csv")
+}
+
+/// Applies a key on the histogram screen.
+pub fn action(app: &mut App, a: Action) -> Vec<Effect> {
+    let Some(st) = app.histogram.as_mut() else {
+        app.screen = Screen::Trials;
+        return vec![];
+    };
+    if let Some(s) = st.suggestion.clone() {
+        return confirm(app, &s, a);
+    }
+    let mut span = st.span;
+    let len = if span.end_s.is_finite() {
+        span.end_s - span.start_s
+    } else {
+        f64::INFINITY
+    };
+    match a {
+        Action::Back => {
+            app.screen = st.from;
+            return vec![];
+        }
+        Action::Up => st.joint = st.joint.saturating_sub(1),
+        Action::Down => st.joint = (st.joint + 1).min(st.hists.len().saturating_sub(1)),
+        Action::Left if len.is_finite() => {
+            span.start_s = (span.start_s - len).max(0.0);
+            span.end_s = span.start_s + len;
+        }
+        Action::Right if len.is_finite() => {
+            span.start_s += len;
+            span.end_s += len;
+        }
+        Action::ZoomIn if len.is_finite() => {
+            span.end_s = span.start_s + (len / 2.0).max(MIN_SPAN_S)
+        }
+        Action::ZoomOut if len.is_finite() => span.end_s = span.start_s + 2.0 * len,
+        Action::Home => span = TimeSpan::FIRST_30_S,
+        Action::End => span = TimeSpan::WHOLE,
+        Action::Enter => return suggest(app),
+        Action::Save => return save_centroids(app),
+        _ => {}
+    }
+    if span != st.span {
+        let files = st.files.clone();
+        let hists = compute(app, &files, span);
+        if let Some(st) = app.histogram.as_mut() {
+            st.span = span;
+            st.hists = hists;
+            st.joint = st.joint.min(st.hists.len().saturating_sub(1));
+        }
+    }
+    vec![]
+}
+
+/// The suggestion from the chosen trials' intervals, pooled per table row.
+fn suggest(app: &mut App) -> Vec<Effect> {
+    let Some(st) = app.histogram.as_ref() else {
+        return vec![];
+    };
+    let refs = refs(app, &st.files);
+    let Some(model) = refs.first().map(|r| r.model) else {
+        return vec![];
+    };
+    let table = &app.limits.table;
+    let pooled = pool_by_table_row(&refs, st.span, table);
+    let hists = histograms(&pooled, table, model, DEFAULT_BIN_DEG);
+    let s = suggest_limits(table, &hists, st.span, SuggestOptions::default());
+    if let Some(st) = app.histogram.as_mut() {
+        st.suggestion = Some(Arc::new(s));
+        st.scroll = 0;
+    }
+    vec![]
+}
+
+/// Keys while the diff is shown: y saves, n or Esc cancels, arrows scroll.
+fn confirm(app: &mut App, s: &Suggestion, a: Action) -> Vec<Effect> {
+    let path = suggested_path(app);
+    let original = app.limits.dir.join(&app.limits.table_name);
+    let Some(st) = app.histogram.as_mut() else {
+        return vec![];
+    };
+    match a {
+        Action::Yes | Action::Save => {
+            st.suggestion = None;
+            return vec![Effect::WriteTable {
+                path,
+                original: Some(original),
+                csv: s.table.to_csv(),
+            }];
+        }
+        Action::No | Action::Back => st.suggestion = None,
+        Action::Up => st.scroll = st.scroll.saturating_sub(1),
+        Action::Down => st.scroll = (st.scroll + 1).min(s.rows.len()),
+        _ => {}
+    }
+    vec![]
+}
+
+fn save_centroids(app: &mut App) -> Vec<Effect> {
+    let Some(st) = app.histogram.as_ref() else {
+        return vec![];
+    };
+    let refs = refs(app, &st.files);
+    let pooled = pool_by_table_row(&refs, st.span, &app.limits.table);
+    let table = centroids(&pooled, st.span);
+    vec![Effect::WriteTable {
+        path: centroids_path(app),
+        original: None,
+        csv: table.to_csv(),
+    }]
+}
+
+/// Writes a table (the work behind [`Effect::WriteTable`]): creates the
+/// folder, saves atomically keeping `.bak`, never over `original`.
+pub fn write_job(path: &Path, original: Option<&Path>, csv: &str) -> Msg {
+    let result = (|| {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        }
+        if let Some(orig) = original.filter(|o| same_file(path, o)) {
+            return Err(WriteError::Original(orig.to_path_buf()).to_string());
+        }
+        crate::save::atomic_write(path, csv.as_bytes())
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(path.display().to_string())
+    })();
+    Msg::TableWritten(result)
+}
+
+/// Reports a finished write in the status bar.
+pub fn written(app: &mut App, result: Result<String, String>) {
+    app.message = Some(match result {
+        Ok(p) => (format!("saved {p}"), false),
+        Err(m) => (format!("cannot save: {m}"), true),
+    });
+}
+
+/// Draws the screen.
+pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+    let Some(st) = app.histogram.as_ref() else {
+        f.render_widget(Paragraph::new("no histograms (Esc)"), area);
+        return;
+    };
+    let left_w = if area.width >= 100 { 30 } else { 24 }.min(area.width / 2);
+    let [left, right] =
+        Layout::horizontal([Constraint::Length(left_w), Constraint::Min(1)]).areas(area);
+    joint_list(st, theme, f, left);
+    let [head, charts] = Layout::vertical([Constraint::Length(1), Constraint::Min(1)]).areas(right);
+    let samples = st
+        .hists
+        .get(st.joint)
+        .and_then(|h| h.axes[0].as_ref())
+        .map_or(0, |a| a.count);
+    f.render_widget(
+        Paragraph::new(Line::from(vec![
+            Span::styled(format!(" {} ", st.span.label()), theme.header),
+            Span::raw(format!(
+                "{} trial(s), {samples} samples  ",
+                st.hists.get(st.joint).map_or(0, |h| h.trials)
+            )),
+            Span::styled("lim", theme.limit),
+            Span::raw(" "),
+            Span::styled("mean", theme.centroid),
+            Span::raw(" "),
+            Span::styled("90%", theme.corrected),
+        ])),
+        head,
+    );
+    if let Some(h) = st.hists.get(st.joint) {
+        let parts = Layout::vertical([Constraint::Ratio(1, 3); 3]).split(charts);
+        for axis in 0..3 {
+            let range = h.limits.map(|l| l.range_deg[axis]);
+            if let Some(a) = &h.axes[axis] {
+                axis_chart(f, parts[axis], theme, axis, a, range);
+            }
+        }
+    } else {
+        f.render_widget(Paragraph::new(" no samples in this span"), charts);
+    }
+    if let Some(s) = &st.suggestion {
+        diff_popup(app, s, st.scroll, theme, f, area);
+    }
+}
+
+fn joint_list(st: &HistogramState, theme: &Theme, f: &mut Frame, area: Rect) {
+    let w = area.width.saturating_sub(1) as usize;
+    let mut lines = vec![Line::from(Span::styled(
+        fit(&format!("{} trial(s)", st.files.len()), w),
+        theme.header,
+    ))];
+    let rows = area.height.saturating_sub(1) as usize;
+    let first = st.joint.saturating_sub(rows.saturating_sub(1));
+    for (k, h) in st.hists.iter().enumerate().skip(first).take(rows) {
+        let n = h.axes[0].as_ref().map_or(0, |a| a.count);
+        let mark = if k == st.joint { ">" } else { " " };
+        let name = fit(&format!("{mark}{}", h.name), w.saturating_sub(7));
+        lines.push(Line::from(format!("{name}{n:>7}")).style(sel(theme, k == st.joint)));
+    }
+    f.render_widget(
+        Paragraph::new(lines).block(Block::new().borders(Borders::RIGHT)),
+        area,
+    );
+}
+
+/// One axis: the bars, the limit lines, the mean and the 90% interval.
+fn axis_chart(
+    f: &mut Frame,
+    area: Rect,
+    theme: &Theme,
+    axis: usize,
+    h: &AxisHistogram,
+    range: Option<[f64; 2]>,
+) {
+    if area.height < 3 || area.width < 12 {
+        return;
+    }
+    let last = h.first_edge_deg + h.counts.len() as f64 * h.bin_deg;
+    let (mut x0, mut x1) = (h.first_edge_deg, last);
+    if let Some([l, u]) = range {
+        x0 = x0.min(l);
+        x1 = x1.max(u);
+    }
+    let pad = ((x1 - x0) * 0.03).max(1.0);
+    let (x0, x1) = (x0 - pad, x1 + pad);
+    let top = f64::from(h.peak()).max(1.0) * 1.05;
+    let bars: Vec<(f64, f64)> = h
+        .counts
+        .iter()
+        .enumerate()
+        .filter(|(_, &c)| c > 0)
+        .map(|(k, &c)| (h.bin_centre(k), f64::from(c)))
+        .collect();
+    let vline = |x: f64| vec![(x, 0.0), (x, top)];
+    let [lo90, hi90] = h.interval_deg;
+    let lines: Vec<(Vec<(f64, f64)>, ratatui::style::Style)> = range
+        .into_iter()
+        .flatten()
+        .map(|x| (vline(x), theme.limit))
+        .chain([
+            (vline(lo90), theme.corrected),
+            (vline(hi90), theme.corrected),
+            (vline(h.mean_deg), theme.centroid),
+        ])
+        .collect();
+    // Lines first: a later dataset overwrites whole cells, and the bars
+    // must stay readable where they cross a line.
+    let mut sets: Vec<Dataset> = lines
+        .iter()
+        .map(|(pts, style)| {
+            Dataset::default()
+                .data(pts)
+                .graph_type(GraphType::Line)
+                .marker(Marker::Braille)
+                .style(*style)
+        })
+        .collect();
+    sets.push(
+        Dataset::default()
+            .data(&bars)
+            .graph_type(GraphType::Bar)
+            .marker(Marker::Braille)
+            .style(theme.raw),
+    );
+    let mut title = vec![
+        Span::styled(format!(" {} ", axis_name(axis)), theme.header),
+        Span::raw(format!("m {:.1} sd {:.1} ", h.mean_deg, h.sd_deg)),
+        Span::styled(format!("90% [{lo90:.1}, {hi90:.1}] "), theme.corrected),
+    ];
+    if let Some([l, u]) = range {
+        title.push(Span::styled(format!("lim [{l}, {u}] "), theme.limit));
+    }
+    let chart = Chart::new(sets)
+        .block(Block::new().borders(Borders::TOP).title(Line::from(title)))
+        .x_axis(
+            Axis::default()
+                .bounds([x0, x1])
+                .labels([format!("{x0:.0}"), format!("{x1:.0}")])
+                .style(theme.dim),
+        )
+        .y_axis(
+            Axis::default()
+                .bounds([0.0, top])
+                .labels(["0".to_string(), format!("{}", h.peak())])
+                .style(theme.dim),
+        )
+        .legend_position(None);
+    f.render_widget(chart, area);
+}
+
+fn diff_popup(app: &App, s: &Suggestion, scroll: usize, theme: &Theme, f: &mut Frame, body: Rect) {
+    let diff = s.diff_lines();
+    let w = (diff.iter().map(|l| l.len()).max().unwrap_or(40) + 4).max(50) as u16;
+    let area = centred(body, w, body.height);
+    f.render_widget(Clear, area);
+    let block = Block::new().borders(Borders::ALL).title(Span::styled(
+        " Suggested limits (90% intervals) ",
+        theme.title,
+    ));
+    let inner = block.inner(area);
+    f.render_widget(block, area);
+    let [head, rows, foot] = Layout::vertical([
+        Constraint::Length(1),
+        Constraint::Min(1),
+        Constraint::Length(2),
+    ])
+    .areas(inner);
+    f.render_widget(
+        Paragraph::new(Span::styled(diff[0].clone(), theme.header)),
+        head,
+    );
+    let body_lines: Vec<Line> = diff[1..]
+        .iter()
+        .skip(scroll)
+        .map(|l| Line::from(l.as_str()))
+        .collect();
+    f.render_widget(Paragraph::new(body_lines), rows);
+    let file = suggested_path(app);
+    let name = file.file_name().map(|n| n.to_string_lossy().into_owned());
+    f.render_widget(
+        Paragraph::new(vec![
+            Line::from(format!(
+                "against {}; saves {} beside it",
+                app.limits.table_name,
+                name.unwrap_or_default()
+            )),
+            Line::from(vec![
+                Span::styled("y", theme.title),
+                Span::raw(" save   "),
+                Span::styled("n", theme.title),
+                Span::raw(" cancel   "),
+                Span::styled("Up/Down", theme.title),
+                Span::raw(" scroll"),
+            ]),
+        ]),
+        foot,
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::app::{open as open_trial, update};
+    use super::super::headless::{buffer_text, draw, load_app, write_demo_folder};
+    use super::super::jobs::SyncRunner;
+    use super::*;
+    use ratatui::crossterm::event::{KeyCode, KeyEvent};
+
+    fn key(app: &mut App, c: KeyCode) {
+        SyncRunner::send(app, Msg::Key(KeyEvent::from(c)));
+    }
+
+    fn snap(name: &str, app: &App) {
+        for (w, h) in super::super::tests::SIZES {
+            let text = buffer_text(&draw(app, &Theme::default(), w, h));
+            insta::assert_snapshot!(format!("{name}_{w}x{h}"), text);
+        }
+    }
+
+    #[test]
+    fn suggest_shows_the_diff_and_saves_beside_the_table() {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path();
+        write_demo_folder(&root.join("trials")).unwrap();
+        let mut app = load_app("trials", &root.join("trials"), &root.join("joint_limits")).unwrap();
+        open_trial(&mut app, "fb.csv.gz".into());
+        key(&mut app, KeyCode::Char('H'));
+        assert_eq!(app.screen, Screen::Histogram);
+        let st = app.histogram.as_ref().unwrap();
+        assert_eq!((st.files.len(), st.hists.len()), (1, 12));
+        assert_eq!(st.span, TimeSpan::FIRST_30_S);
+        // 30 s at 50 Hz.
+        assert_eq!(st.hists[0].axes[0].as_ref().unwrap().count, 1500);
+        key(&mut app, KeyCode::Down);
+        key(&mut app, KeyCode::Enter);
+        assert!(app.histogram.as_ref().unwrap().suggestion.is_some());
+        snap("histogram_diff", &app);
+        // n cancels; Enter again and y saves beside the (built-in) table.
+        key(&mut app, KeyCode::Char('n'));
+        assert!(app.histogram.as_ref().unwrap().suggestion.is_none());
+        key(&mut app, KeyCode::Enter);
+        key(&mut app, KeyCode::Char('y'));
+        let saved = root.join("joint_limits/table_3_2.suggested.csv");
+        let t = LimitTable::load(&saved).unwrap();
+        assert_eq!(t.rows.len(), app.limits.table.rows.len());
+        assert!(!root.join("joint_limits/table_3_2.csv").exists());
+        assert!(
+            app.message.as_ref().unwrap().0.starts_with("saved "),
+            "{:?}",
+            app.message
+        );
+        // w saves the centroid table.
+        key(&mut app, KeyCode::Char('w'));
+        let c = std::fs::read_to_string(root.join("joint_limits/centroids.csv")).unwrap();
+        assert!(
+            c.contains("\njoint,axis,centroid_deg,sd_deg,samples,trials\nback,X,"),
+            "{c}"
+        );
+        // The next 30 s of a 30 s trial hold nothing; Home comes back.
+        key(&mut app, KeyCode::Right);
+        assert!(app.histogram.as_ref().unwrap().hists.is_empty());
+        snap("histogram_empty", &app);
+        key(&mut app, KeyCode::Home);
+        assert_eq!(app.histogram.as_ref().unwrap().hists.len(), 12);
+        key(&mut app, KeyCode::End);
+        assert_eq!(app.histogram.as_ref().unwrap().span, TimeSpan::WHOLE);
+        key(&mut app, KeyCode::Esc);
+        assert_eq!(app.screen, Screen::Trial);
+        // From the trials screen: every loaded trial the list shows.
+        key(&mut app, KeyCode::Esc);
+        let fx = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('H'))));
+        assert!(fx.is_empty());
+        assert_eq!(
+            app.histogram.as_ref().unwrap().files,
+            ["fb.csv.gz", "knee.csv"]
+        );
+    }
+
+    #[test]
+    fn a_table_is_never_written_over_the_original() {
+        let tmp = tempfile::tempdir().unwrap();
+        let p = tmp.path().join("t.csv");
+        std::fs::write(&p, "x").unwrap();
+        let Msg::TableWritten(r) = write_job(&p, Some(&p), "y") else {
+            panic!()
+        };
+        assert!(r.unwrap_err().contains("never written over"));
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "x");
+        let Msg::TableWritten(r) = write_job(&tmp.path().join("new/c.csv"), Some(&p), "y") else {
+            panic!()
+        };
+        assert!(r.unwrap().ends_with("c.csv"));
+    }
+}
