@@ -1,10 +1,13 @@
 //! A trial's figures before and after each correction variant, as a data
 //! structure (for JSON and screens) and as aligned text tables (for terminals).
 
+use crate::acm::window::{borrow_notes, layout};
 use crate::acm::{correct_trial, Cancelled, Correction, RunControl, SkippedJoint, Variant};
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
+use crate::trial::glitch::{glitch_note, glitches, Glitch, DEFAULT_GLITCH_DEG};
+use crate::trial::timing::{timing, Timing};
 use crate::trial::Trial;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -34,6 +37,27 @@ pub struct TrialReport {
     pub uncorrected: Vec<JointFigures>,
     pub variants: Vec<VariantReport>,
     pub warnings: Vec<String>,
+    /// Spacing of the sample times: irregular intervals and gaps.
+    #[serde(default)]
+    pub timing: Timing,
+    /// Windows of the windowed variants that borrowed their neighbours' samples.
+    #[serde(default)]
+    pub borrowed_windows: Vec<String>,
+    /// Threshold of the glitch search, degrees between neighbouring samples.
+    #[serde(default)]
+    pub glitch_deg: f64,
+    /// Orientation jumps over `glitch_deg` (reported, not smoothed).
+    #[serde(default)]
+    pub glitches: Vec<Glitch>,
+}
+
+impl TrialReport {
+    /// Searches `trial` (the one reported on) for glitches over `deg` instead of
+    /// the default threshold.
+    pub fn set_glitch_threshold(&mut self, trial: &Trial, deg: f64) {
+        self.glitch_deg = deg;
+        self.glitches = glitches(trial, deg);
+    }
 }
 
 /// Inputs of a report.
@@ -78,6 +102,18 @@ impl ReportInput<'_> {
                 })
                 .collect(),
             warnings: t.warnings.clone(),
+            timing: timing(&t.time_s),
+            borrowed_windows: if corrections.iter().any(|c| c.variant.windowed()) {
+                borrow_notes(&layout(
+                    &t.time_s,
+                    self.settings.window_s,
+                    self.settings.hop_s,
+                ))
+            } else {
+                Vec::new()
+            },
+            glitch_deg: DEFAULT_GLITCH_DEG,
+            glitches: glitches(t, DEFAULT_GLITCH_DEG),
         }
     }
 
@@ -181,6 +217,12 @@ pub fn format_text(r: &TrialReport) -> String {
     );
     for w in &r.warnings {
         let _ = writeln!(out, "warning: {w}");
+    }
+    for n in r.timing.notes().iter().chain(&r.borrowed_windows) {
+        let _ = writeln!(out, "time: {n}");
+    }
+    if let Some(g) = glitch_note(&r.glitches, r.glitch_deg) {
+        let _ = writeln!(out, "glitches: {g}");
     }
     if let Some(v) = r.variants.first().filter(|v| !v.skipped.is_empty()) {
         let list: Vec<String> = v

@@ -15,6 +15,10 @@ pub struct ReportArgs {
     /// Variants to run and compare (repeatable) [default: all].
     #[arg(long, value_enum)]
     pub variant: Vec<Variant>,
+    /// Flag orientation jumps larger than this between neighbouring samples,
+    /// degrees [default: 30].
+    #[arg(long, value_parser = positive_deg)]
+    pub glitch_deg: Option<f64>,
     /// Print JSON instead of text tables.
     #[arg(long)]
     pub json: bool,
@@ -26,6 +30,16 @@ pub struct ReportArgs {
     /// No progress output.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// A positive, finite angle in degrees.
+fn positive_deg(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "expected a positive number of degrees, found '{s}'"
+        )),
+    }
 }
 
 /// Runs `acmw report`.
@@ -70,7 +84,10 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         settings: &ctx.settings,
         truth: truth.as_ref().map(|t| &t.segments),
     };
-    let r = input.run(&variants, &control)?;
+    let mut r = input.run(&variants, &control)?;
+    if let Some(deg) = args.glitch_deg {
+        r.set_glitch_threshold(&trial, deg);
+    }
     progress.finish();
     if args.json {
         println!("{}", serde_json::to_string_pretty(&r)?);

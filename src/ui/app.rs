@@ -50,6 +50,8 @@ pub struct Loaded {
     pub before: Vec<JointFigures>,
     /// Joint angles of the uncorrected trial, filled on demand.
     pub angles: AngleCache,
+    /// Orientation jumps over the default threshold, by time (key `G`).
+    pub glitches: Vec<crate::trial::glitch::Glitch>,
 }
 
 /// Whether a trial is read yet.
@@ -1161,6 +1163,7 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::Home => app.view.cursor_s = 0.0,
         Action::End => app.view.cursor_s = d,
         Action::Marker => app.view.braille = !app.view.braille,
+        Action::NextGlitch => next_glitch(app),
         Action::Variant => next_variant(app),
         Action::Scatter => super::views::open(app, super::views::ViewKind::Scatter),
         Action::Globe => super::views::open(app, super::views::ViewKind::Globe),
@@ -1183,7 +1186,7 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
     // Keep the cursor in view when it moved.
     if matches!(
         a,
-        Action::CursorLeft | Action::CursorRight | Action::Home | Action::End
+        Action::CursorLeft | Action::CursorRight | Action::Home | Action::End | Action::NextGlitch
     ) {
         let (s0, s1) = app.view.span(d);
         let w = s1 - s0;
@@ -1193,6 +1196,20 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         }
     }
     vec![]
+}
+
+/// Moves the cursor to the selected joint's next glitch (wrapping).
+fn next_glitch(app: &mut App) {
+    let Some(l) = app.open_entry().and_then(|e| e.loaded()) else {
+        return;
+    };
+    let Some(joint) = l.before.get(app.joint).map(|f| f.joint.clone()) else {
+        return;
+    };
+    let found = super::glitches::of_joint(l, &joint);
+    if let Some(t) = super::glitches::next_after(&found, app.view.cursor_s) {
+        app.view.cursor_s = t;
+    }
 }
 
 fn compare_action(app: &mut App, a: Action) -> Vec<Effect> {

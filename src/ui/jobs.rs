@@ -8,6 +8,7 @@ use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
 use crate::report::ReportInput;
 use crate::sidecar::{default_output, SaveRequest};
+use crate::trial::glitch::{glitches, DEFAULT_GLITCH_DEG};
 use crate::trial::xsens_trial::{is_mapping_file, resolve};
 use crate::trial::{detect_format, detect_model, is_trial_path, read_trial, TrialError};
 use crate::truth::load_truth_beside;
@@ -94,7 +95,9 @@ pub fn load_trial(file: &str, path: &Path, limits: &LimitTable) -> Msg {
             Some(Err(e)) => (None, Some(shown(e))),
         };
         let before = trial_figures(&trial, None, truth.as_ref(), &model, limits);
+        let glitches = glitches(&trial, DEFAULT_GLITCH_DEG);
         Ok(Arc::new(Loaded {
+            glitches,
             trial,
             model,
             format,

@@ -13,6 +13,7 @@ pub mod app;
 pub mod applied;
 pub mod calibration;
 pub mod compare;
+pub mod glitches;
 pub mod globe;
 pub mod headless;
 pub mod histogram;

@@ -148,11 +148,13 @@ fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
         Scope::Views,
     ];
     let mut items: Vec<Line> = vec![];
+    let mut headings = vec![];
     for scope in order {
         let entries: Vec<_> = help_lines().into_iter().filter(|l| l.2 == scope).collect();
         if entries.is_empty() {
             continue;
         }
+        headings.push(items.len());
         items.push(Line::from(Span::styled(scope.title(), theme.header)));
         for (keys, text, _) in entries {
             items.push(Line::from(vec![
@@ -164,6 +166,13 @@ fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
     // Two columns when the list is taller than the screen.
     let inner_h = body.height.saturating_sub(3) as usize;
     let two = items.len() > inner_h && body.width >= 78;
+    // A heading never ends the left column: it moves to the right one.
+    if two {
+        let half = items.len().div_ceil(2);
+        if headings.contains(&(half - 1)) {
+            items.insert(half - 1, Line::default());
+        }
+    }
     let w = if two { 78 } else { 50 };
     let rows = if two {
         items.len().div_ceil(2)
