@@ -280,6 +280,11 @@ pub struct Model {
     /// Heading axes for pose calibration.
     #[serde(default, skip_serializing_if = "is_default")]
     pub pose: PoseSetup,
+    /// Optional direction of each segment in its IMU's frame, in the zero pose
+    /// (every joint angle 0), from the end nearer the base to the far end; for
+    /// stick figures. Unit-free (normalised on use).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub segment_direction: BTreeMap<String, [f64; 3]>,
 }
 
 /// Why a model file was rejected.

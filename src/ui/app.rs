@@ -159,6 +159,8 @@ pub enum Screen {
     Trial,
     Compare,
     Limits,
+    /// The analysis views (`super::views`).
+    Views,
     Calibration,
     Histogram,
 }
@@ -415,6 +417,8 @@ pub struct App {
     /// A message in the status bar: (text, is_error).
     pub message: Option<(String, bool)>,
     pub quit: bool,
+    /// State of the analysis views.
+    pub views: super::views::ViewsState,
     /// The calibration screen (`super::calibration`).
     pub calib: super::calibration::CalibState,
     /// The histogram screen, once opened.
@@ -512,6 +516,8 @@ pub enum Msg {
     /// The limit files on disk differ from what the workbench last loaded or saved.
     LimitsOnDisk(LimitTable, SettingsFile),
     RecorrectDue,
+    /// Time passes (only sent while something plays).
+    Tick,
     /// The calibration recordings of the folder, read and calibrated (protocol label).
     Calibrations(Vec<super::calibration::CalibEntry>, String),
     /// A suggested limit table or a centroid table was written (its path), or why not.
@@ -544,6 +550,7 @@ impl App {
             limits_from: Screen::Trials,
             message: None,
             quit: false,
+            views: Default::default(),
             calib: Default::default(),
             histogram: None,
         };
@@ -843,6 +850,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
         }
         Msg::RecorrectDue => recorrect_now(app),
+        Msg::Tick => {
+            super::views::tick(app);
+            vec![]
+        }
         Msg::Calibrations(entries, protocol) => {
             super::calibration::loaded(app, entries, protocol);
             vec![]
@@ -1073,6 +1084,10 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Trial => trial_action(app, a),
         Screen::Compare => compare_action(app, a),
         Screen::Limits => limits_action(app, a),
+        Screen::Views => {
+            super::views::action(app, a);
+            vec![]
+        }
         Screen::Calibration => super::calibration::action(app, a),
         Screen::Histogram => super::histogram::action(app, a),
     }
@@ -1137,7 +1152,7 @@ pub fn open(app: &mut App, file: String) {
     app.screen = Screen::Trial;
 }
 
-fn next_variant(app: &mut App) {
+pub(super) fn next_variant(app: &mut App) {
     let k = Variant::ALL
         .iter()
         .position(|v| *v == app.variant)
@@ -1169,6 +1184,10 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::NextGlitch => next_glitch(app),
         Action::Variant => next_variant(app),
         Action::Pose => return super::pose::toggle(app),
+        Action::Scatter => super::views::open(app, super::views::ViewKind::Scatter),
+        Action::Globe => super::views::open(app, super::views::ViewKind::Globe),
+        Action::Applied => super::views::open(app, super::views::ViewKind::Applied),
+        Action::Stick => super::views::open(app, super::views::ViewKind::Stick),
         Action::Compare => {
             app.compare_col = Variant::ALL
                 .iter()

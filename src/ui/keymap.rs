@@ -38,6 +38,12 @@ pub enum Action {
     TakeFile,
     Yes,
     No,
+    Scatter,
+    Globe,
+    Applied,
+    Stick,
+    Play,
+    TimeColour,
 }
 
 /// Where a binding applies, for the help overlay.
@@ -48,6 +54,7 @@ pub enum Scope {
     Trial,
     Compare,
     Limits,
+    Views,
 }
 
 impl Scope {
@@ -58,6 +65,7 @@ impl Scope {
             Scope::Trial => "trial",
             Scope::Compare => "compare",
             Scope::Limits => "limits",
+            Scope::Views => "views",
         }
     }
 }
@@ -105,6 +113,12 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "w", code: &[KeyCode::Char('w')], action: Action::Save, scope: Scope::Everywhere, help: "save variant / limits" },
     Binding { keys: "K / T", code: &[KeyCode::Char('K')], action: Action::KeepMine, scope: Scope::Limits, help: "reload: mine / file's" },
     Binding { keys: "", code: &[KeyCode::Char('T')], action: Action::TakeFile, scope: Scope::Limits, help: "" },
+    Binding { keys: "x", code: &[KeyCode::Char('x')], action: Action::Scatter, scope: Scope::Trial, help: "3-D scatter view" },
+    Binding { keys: "o", code: &[KeyCode::Char('o')], action: Action::Globe, scope: Scope::Trial, help: "globographic view" },
+    Binding { keys: "a", code: &[KeyCode::Char('a')], action: Action::Applied, scope: Scope::Trial, help: "applied correction view" },
+    Binding { keys: "f", code: &[KeyCode::Char('f')], action: Action::Stick, scope: Scope::Trial, help: "stick figure view" },
+    Binding { keys: "t", code: &[KeyCode::Char('t')], action: Action::TimeColour, scope: Scope::Views, help: "colour by time / limits" },
+    Binding { keys: "p", code: &[KeyCode::Char('p')], action: Action::Play, scope: Scope::Views, help: "play / pause (or Space)" },
     Binding { keys: "y / n", code: &[KeyCode::Char('y')], action: Action::Yes, scope: Scope::Everywhere, help: "answer a question" },
     Binding { keys: "", code: &[KeyCode::Char('n')], action: Action::No, scope: Scope::Everywhere, help: "" },
 ];

@@ -16,22 +16,22 @@ use std::path::Path;
 /// Sizes every screen is checked at.
 pub const SIZES: [(u16, u16); 2] = [(80, 24), (120, 40)];
 
-struct Fixture {
+pub(super) struct Fixture {
     tmp: tempfile::TempDir,
 }
 
 impl Fixture {
-    fn new() -> Fixture {
+    pub(super) fn new() -> Fixture {
         let tmp = tempfile::tempdir().unwrap();
         write_demo_folder(&tmp.path().join("trials")).unwrap();
         Fixture { tmp }
     }
 
-    fn root(&self) -> &Path {
+    pub(super) fn root(&self) -> &Path {
         self.tmp.path()
     }
 
-    fn app(&self) -> App {
+    pub(super) fn app(&self) -> App {
         load_app(
             "trials",
             &self.root().join("trials"),
@@ -41,23 +41,23 @@ impl Fixture {
     }
 }
 
-fn key(app: &mut App, c: KeyCode) {
+pub(super) fn key(app: &mut App, c: KeyCode) {
     SyncRunner::send(app, Msg::Key(KeyEvent::from(c)));
 }
 
-fn keys(app: &mut App, s: &str) {
+pub(super) fn keys(app: &mut App, s: &str) {
     for c in s.chars() {
         key(app, KeyCode::Char(c));
     }
 }
 
-fn terminal(app: &App, w: u16, h: u16) -> Terminal<TestBackend> {
+pub(super) fn terminal(app: &App, w: u16, h: u16) -> Terminal<TestBackend> {
     let mut t = Terminal::new(TestBackend::new(w, h)).unwrap();
     t.draw(|f| render(app, &Theme::default(), f)).unwrap();
     t
 }
 
-fn snap(name: &str, app: &App) {
+pub(super) fn snap(name: &str, app: &App) {
     for (w, h) in SIZES {
         let t = terminal(app, w, h);
         insta::assert_snapshot!(format!("{name}_{w}x{h}"), t.backend());
