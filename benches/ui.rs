@@ -1,5 +1,5 @@
-//! Workbench benchmarks (issue 4): drawing the trial screen of a 30-minute,
-//! 13-IMU trial at 200x60, and the first frame on a folder of 100 trials
+//! Workbench benchmarks (issues 4 and 7): drawing the trial screen and the
+//! analysis views of a 30-minute, 13-IMU trial at 200x60, and the first frame on a folder of 100 trials
 //! (file names only: trials load in the background after it).
 //!
 //! Run with `cargo bench --bench ui`.
@@ -43,6 +43,32 @@ fn benches(c: &mut Criterion) {
     c.bench_function("render trial screen to a new buffer, 200x60", |b| {
         b.iter(|| draw(&app, &theme, 200, 60))
     });
+
+    // The analysis views (issue 7) of the same trial, each drawn as the
+    // runtime draws it; the globe also on a shoulder (a wide limit band).
+    for (view, joint) in [
+        ("scatter", "l_knee"),
+        ("globe", "l_knee"),
+        ("globe", "l_shoulder"),
+        ("applied", "l_knee"),
+        ("stick", "l_knee"),
+    ] {
+        let mut v = app.clone();
+        let s = Show {
+            screen: view.into(),
+            trial: Some("long.csv".into()),
+            joint: Some(joint.into()),
+            variant: None,
+        };
+        show(&mut v, &s).unwrap();
+        v.views.time_s = 900.0;
+        // The first frame fills the angle caches, as the first frame on screen does.
+        term.draw(|f| render(&v, &theme, f)).unwrap();
+        c.bench_function(
+            &format!("draw {view} view ({joint}), 30 min trial, 200x60"),
+            |b| b.iter(|| term.draw(|f| render(&v, &theme, f)).map(|_| ()).unwrap()),
+        );
+    }
 
     // A folder of 100 trials: list, build the state, draw the first frame.
     let many = tempfile::tempdir().unwrap();

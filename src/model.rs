@@ -19,6 +19,164 @@ pub const BUILTIN_MODELS: &[(&str, &str)] = &[
     ("full_body16", include_str!("../models/full_body16.toml")),
 ];
 
+/// An axis of a joint's Z-Y-X Euler angles (METHOD.md section 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+pub enum Axis {
+    #[serde(rename = "x", alias = "X")]
+    X,
+    #[serde(rename = "y", alias = "Y")]
+    Y,
+    #[serde(rename = "z", alias = "Z")]
+    Z,
+}
+
+impl Axis {
+    /// All three, in the order of the angle triples `[x, y, z]`.
+    pub const ALL: [Axis; 3] = [Axis::X, Axis::Y, Axis::Z];
+
+    /// Index into `[x, y, z]`.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// `x`, `y` or `z`.
+    pub fn name(self) -> &'static str {
+        ["x", "y", "z"][self.index()]
+    }
+}
+
+/// Hard limits of a joint's coordinates, degrees, `[lower, upper]` per axis
+/// (absent = unlimited). Inverse kinematics never leaves them.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct HardLimits {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x: Option<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y: Option<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub z: Option<[f64; 2]>,
+}
+
+impl HardLimits {
+    /// The limits of one axis, degrees.
+    pub fn get(&self, axis: Axis) -> Option<[f64; 2]> {
+        [self.x, self.y, self.z][axis.index()]
+    }
+
+    fn is_empty(&self) -> bool {
+        *self == HardLimits::default()
+    }
+}
+
+/// A sensor axis with a sign, e.g. `+x` or `-z`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct SignedAxis {
+    pub axis: Axis,
+    pub negative: bool,
+}
+
+impl SignedAxis {
+    /// `+x`.
+    pub const PLUS_X: SignedAxis = SignedAxis {
+        axis: Axis::X,
+        negative: false,
+    };
+
+    /// The unit vector `[x, y, z]`.
+    pub fn vector(self) -> [f64; 3] {
+        let mut v = [0.0; 3];
+        v[self.axis.index()] = if self.negative { -1.0 } else { 1.0 };
+        v
+    }
+}
+
+impl std::str::FromStr for SignedAxis {
+    type Err = String;
+    fn from_str(s: &str) -> Result<SignedAxis, String> {
+        let t = s.trim().to_ascii_lowercase();
+        let (negative, rest) = match t.as_bytes().first() {
+            Some(b'-') => (true, &t[1..]),
+            Some(b'+') => (false, &t[1..]),
+            _ => (false, t.as_str()),
+        };
+        let axis = match rest {
+            "x" => Axis::X,
+            "y" => Axis::Y,
+            "z" => Axis::Z,
+            _ => {
+                return Err(format!(
+                    "'{s}' is not an axis (expected +x, -x, +y, -y, +z or -z)"
+                ))
+            }
+        };
+        Ok(SignedAxis { axis, negative })
+    }
+}
+
+impl TryFrom<String> for SignedAxis {
+    type Error = String;
+    fn try_from(s: String) -> Result<SignedAxis, String> {
+        s.parse()
+    }
+}
+
+impl From<SignedAxis> for String {
+    fn from(a: SignedAxis) -> String {
+        a.to_string()
+    }
+}
+
+impl std::fmt::Display for SignedAxis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}{}",
+            if self.negative { "-" } else { "+" },
+            self.axis.name()
+        )
+    }
+}
+
+/// How pose calibration finds the subject's heading (METHOD.md section 9).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseSetup {
+    /// The base IMU's sensor axis that points forward in the calibration pose.
+    #[serde(default = "plus_x")]
+    pub base_forward: SignedAxis,
+    /// The model's forward direction in the (horizontal) global frame; the
+    /// vertical is global +Z.
+    #[serde(default = "plus_x")]
+    pub forward: SignedAxis,
+}
+
+fn plus_x() -> SignedAxis {
+    SignedAxis::PLUS_X
+}
+
+impl Default for PoseSetup {
+    fn default() -> PoseSetup {
+        PoseSetup {
+            base_forward: SignedAxis::PLUS_X,
+            forward: SignedAxis::PLUS_X,
+        }
+    }
+}
+
+fn is_default<T: Default + PartialEq>(v: &T) -> bool {
+    *v == T::default()
+}
+
+fn all_axes() -> Vec<Axis> {
+    Axis::ALL.to_vec()
+}
+
+fn is_all_axes(v: &[Axis]) -> bool {
+    v == Axis::ALL
+}
+
 /// One joint: the rotation of the distal IMU relative to the proximal one.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Joint {
@@ -30,6 +188,69 @@ pub struct Joint {
     pub proximal: String,
     /// IMU below the joint (the one the ACM corrects).
     pub distal: String,
+    /// Degrees of freedom for inverse kinematics: the axes of the joint's
+    /// Z-Y-X angles that move (`["y"]` for a hinge knee); all three when absent.
+    /// The others stay at their `default_pose_deg` value.
+    #[serde(default = "all_axes", skip_serializing_if = "is_all_axes")]
+    pub dof: Vec<Axis>,
+    /// Hard limits of the moving axes, degrees (inverse kinematics only; the
+    /// ACM uses the limit tables).
+    #[serde(default, skip_serializing_if = "HardLimits::is_empty")]
+    pub hard_limits_deg: HardLimits,
+    /// The joint's Z-Y-X angles `[x, y, z]` in the model's default pose,
+    /// degrees (pose calibration takes the IMUs to show this pose).
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub default_pose_deg: [f64; 3],
+}
+
+impl Joint {
+    /// Whether inverse kinematics moves this axis.
+    pub fn moves(&self, axis: Axis) -> bool {
+        self.dof.contains(&axis)
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let name = &self.name;
+        for (k, a) in self.dof.iter().enumerate() {
+            if self.dof[..k].contains(a) {
+                return Err(format!(
+                    "joint '{name}': axis '{}' is listed twice in `dof`",
+                    a.name()
+                ));
+            }
+        }
+        for axis in Axis::ALL {
+            let pose = self.default_pose_deg[axis.index()];
+            if !(pose.is_finite() && (-180.0..=180.0).contains(&pose)) {
+                return Err(format!(
+                    "joint '{name}': default_pose_deg.{} = {pose} is not within -180..180",
+                    axis.name()
+                ));
+            }
+            let Some([lo, hi]) = self.hard_limits_deg.get(axis) else {
+                continue;
+            };
+            if !self.moves(axis) {
+                return Err(format!(
+                    "joint '{name}': hard_limits_deg.{0} limits an axis that is not in `dof`",
+                    axis.name()
+                ));
+            }
+            if !(lo.is_finite() && hi.is_finite() && -180.0 <= lo && lo < hi && hi <= 180.0) {
+                return Err(format!(
+                    "joint '{name}': hard_limits_deg.{} = [{lo}, {hi}]: expected lower < upper within -180..180",
+                    axis.name()
+                ));
+            }
+            if !(lo..=hi).contains(&pose) {
+                return Err(format!(
+                    "joint '{name}': default_pose_deg.{} = {pose} is outside its hard limits [{lo}, {hi}]",
+                    axis.name()
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A body model: which IMUs exist, how they form joints, in which order to correct.
@@ -53,6 +274,17 @@ pub struct Model {
     /// Optional segment lengths in metres, keyed by IMU (for stick figures).
     #[serde(default)]
     pub segment_length_m: BTreeMap<String, f64>,
+    /// Weight of each IMU's orientation error in inverse kinematics (1 when absent).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub imu_weight: BTreeMap<String, f64>,
+    /// Heading axes for pose calibration.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub pose: PoseSetup,
+    /// Optional direction of each segment in its IMU's frame, in the zero pose
+    /// (every joint angle 0), from the end nearer the base to the far end; for
+    /// stick figures. Unit-free (normalised on use).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub segment_direction: BTreeMap<String, [f64; 3]>,
 }
 
 /// Why a model file was rejected.
@@ -147,6 +379,25 @@ impl Model {
                 ));
             }
         }
+        for j in &self.joints {
+            j.validate()?;
+        }
+        if self.pose.forward.axis == Axis::Z {
+            return Err(format!(
+                "pose.forward = {}: the model's forward axis must be horizontal (x or y; +z is vertical)",
+                self.pose.forward
+            ));
+        }
+        for (imu, w) in &self.imu_weight {
+            if !imus.contains(imu.as_str()) {
+                return Err(format!("imu_weight: IMU '{imu}' is not in `imus`"));
+            }
+            if !(w.is_finite() && *w > 0.0) {
+                return Err(format!(
+                    "imu_weight.{imu} = {w}: expected a positive number"
+                ));
+            }
+        }
         for (alias, canon) in &self.aliases {
             if !imus.contains(canon.as_str()) {
                 return Err(format!("alias '{alias}' points to unknown IMU '{canon}'"));
@@ -174,6 +425,11 @@ impl Model {
                     .map(|(_, c)| c)
             })
             .map(String::as_str)
+    }
+
+    /// The inverse-kinematics weight of an IMU (1 unless the model says otherwise).
+    pub fn weight(&self, imu: &str) -> f64 {
+        self.imu_weight.get(imu).copied().unwrap_or(1.0)
     }
 
     /// The joint with this name.
@@ -306,5 +562,76 @@ distal = "b"
             .unwrap_err()
             .to_string();
         assert!(e.contains("m.toml") && e.contains("line 1"), "{e}");
+    }
+
+    #[test]
+    fn dof_limits_and_pose_declarations() {
+        let m = Model::infant13();
+        let knee = m.joint("l_knee").unwrap();
+        assert_eq!(knee.dof, [Axis::Y]);
+        assert_eq!(knee.hard_limits_deg.get(Axis::Y), Some([-10.0, 150.0]));
+        assert!(!knee.moves(Axis::X));
+        let hip = m.joint("l_hip").unwrap();
+        assert_eq!(hip.dof, Axis::ALL);
+        assert_eq!(hip.hard_limits_deg, HardLimits::default());
+        assert_eq!(m.pose, PoseSetup::default());
+        assert_eq!(m.weight("head"), 1.0);
+        let o = Model::builtin("opensim").unwrap();
+        assert_eq!(o.pose.base_forward.to_string(), "-z");
+        assert_eq!(o.pose.base_forward.vector(), [0.0, 0.0, -1.0]);
+        // A model without the new keys serialises as before (sidecars stay the same).
+        let plain = r#"
+name = "x"
+base = "a"
+imus = ["a", "b"]
+[[joint]]
+name = "j"
+kind = "knee"
+proximal = "a"
+distal = "b"
+"#;
+        let m = Model::from_toml(plain, "m.toml").unwrap();
+        let json = serde_json::to_string(&m).unwrap();
+        assert!(!json.contains("dof") && !json.contains("pose"), "{json}");
+        // Round trip with everything declared.
+        let full = format!(
+            "{plain}dof = [\"Y\", \"z\"]\nhard_limits_deg = {{ y = [0, 140] }}\ndefault_pose_deg = [0, 10, 0]\n[imu_weight]\nb = 2.0\n[pose]\nbase_forward = \"-y\"\n"
+        );
+        let m = Model::from_toml(&full, "m.toml").unwrap();
+        assert_eq!(m.joints[0].dof, [Axis::Y, Axis::Z]);
+        assert_eq!(m.weight("b"), 2.0);
+        assert_eq!(m.pose.base_forward.vector(), [0.0, -1.0, 0.0]);
+        let back: Model = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
+        assert_eq!(back, m);
+    }
+
+    #[test]
+    fn bad_dof_and_limits_are_rejected_with_reason() {
+        let base = "name = \"x\"\nbase = \"a\"\nimus = [\"a\", \"b\"]\n[[joint]]\nname = \"j\"\nkind = \"knee\"\nproximal = \"a\"\ndistal = \"b\"\n";
+        let cases = [
+            ("dof = [\"y\", \"y\"]", "listed twice"),
+            ("dof = [\"w\"]", "line"),
+            (
+                "dof = [\"y\"]\nhard_limits_deg = { x = [0, 10] }",
+                "not in `dof`",
+            ),
+            ("hard_limits_deg = { y = [10, 0] }", "lower < upper"),
+            ("hard_limits_deg = { y = [0, 200] }", "within -180..180"),
+            (
+                "hard_limits_deg = { y = [0, 100] }\ndefault_pose_deg = [0, -5, 0]",
+                "outside its hard limits",
+            ),
+            ("hard_limits_deg = { q = [0, 100] }", "unknown field"),
+            ("[imu_weight]\nb = -1", "positive"),
+            ("[imu_weight]\nc = 1", "'c' is not in"),
+            ("[pose]\nbase_forward = \"up\"", "not an axis"),
+            ("[pose]\nforward = \"-z\"", "must be horizontal"),
+        ];
+        for (extra, want) in cases {
+            let e = Model::from_toml(&format!("{base}{extra}\n"), "m.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("m.toml") && e.contains(want), "{extra}: {e}");
+        }
     }
 }

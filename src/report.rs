@@ -1,12 +1,17 @@
 //! A trial's figures before and after each correction variant, as a data
 //! structure (for JSON and screens) and as aligned text tables (for terminals).
 
+use crate::acm::window::{borrow_notes, layout};
 use crate::acm::{
     correct_trial, Cancelled, Correction, ImuHeading, RunControl, SkippedJoint, Variant,
 };
+use crate::ik::IkSummary;
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
+use crate::pose::PoseRecord;
+use crate::trial::glitch::{glitch_note, glitches, Glitch, DEFAULT_GLITCH_DEG};
+use crate::trial::timing::{timing, Timing};
 use crate::trial::Trial;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -20,6 +25,9 @@ pub struct VariantReport {
     /// Estimated heading drift per IMU (heading-drift variants only).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub headings: Vec<ImuHeading>,
+    /// The `ik` variant's solver figures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ik: Option<IkSummary>,
 }
 
 /// A trial's figures, uncorrected and per variant.
@@ -39,6 +47,30 @@ pub struct TrialReport {
     pub uncorrected: Vec<JointFigures>,
     pub variants: Vec<VariantReport>,
     pub warnings: Vec<String>,
+    /// The pose calibration the trial went through before correction.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pose_calibration: Option<PoseRecord>,
+    /// Spacing of the sample times: irregular intervals and gaps.
+    #[serde(default)]
+    pub timing: Timing,
+    /// Windows of the windowed variants that borrowed their neighbours' samples.
+    #[serde(default)]
+    pub borrowed_windows: Vec<String>,
+    /// Threshold of the glitch search, degrees between neighbouring samples.
+    #[serde(default)]
+    pub glitch_deg: f64,
+    /// Orientation jumps over `glitch_deg` (reported, not smoothed).
+    #[serde(default)]
+    pub glitches: Vec<Glitch>,
+}
+
+impl TrialReport {
+    /// Searches `trial` (the one reported on) for glitches over `deg` instead of
+    /// the default threshold.
+    pub fn set_glitch_threshold(&mut self, trial: &Trial, deg: f64) {
+        self.glitch_deg = deg;
+        self.glitches = glitches(trial, deg);
+    }
 }
 
 /// Inputs of a report.
@@ -81,9 +113,23 @@ impl ReportInput<'_> {
                     ),
                     skipped: c.skipped.clone(),
                     headings: c.headings.clone(),
+                    ik: c.ik.as_ref().map(|r| r.summary()),
                 })
                 .collect(),
             warnings: t.warnings.clone(),
+            pose_calibration: None,
+            timing: timing(&t.time_s),
+            borrowed_windows: if corrections.iter().any(|c| c.variant.windowed()) {
+                borrow_notes(&layout(
+                    &t.time_s,
+                    self.settings.window_s,
+                    self.settings.hop_s,
+                ))
+            } else {
+                Vec::new()
+            },
+            glitch_deg: DEFAULT_GLITCH_DEG,
+            glitches: glitches(t, DEFAULT_GLITCH_DEG),
         }
     }
 
@@ -242,6 +288,19 @@ pub fn format_text(r: &TrialReport) -> String {
     for w in &r.warnings {
         let _ = writeln!(out, "warning: {w}");
     }
+    if let Some(p) = &r.pose_calibration {
+        let _ = writeln!(
+            out,
+            "pose calibration at {} s ({} samples): heading corrected by {:.2} deg; \"uncorrected\" is the calibrated trial",
+            p.calibration.at, p.samples, p.heading_deg
+        );
+    }
+    for n in r.timing.notes().iter().chain(&r.borrowed_windows) {
+        let _ = writeln!(out, "time: {n}");
+    }
+    if let Some(g) = glitch_note(&r.glitches, r.glitch_deg) {
+        let _ = writeln!(out, "glitches: {g}");
+    }
     if let Some(v) = r.variants.first().filter(|v| !v.skipped.is_empty()) {
         let list: Vec<String> = v
             .skipped
@@ -304,5 +363,31 @@ pub fn format_text(r: &TrialReport) -> String {
     for v in r.variants.iter().filter(|v| v.variant.heading()) {
         heading_table(&mut out, v);
     }
+    for v in &r.variants {
+        if let Some(ik) = &v.ik {
+            ik_text(&mut out, ik);
+        }
+    }
     out
+}
+
+fn ik_text(out: &mut String, s: &IkSummary) {
+    let _ = writeln!(
+        out,
+        "\nInverse kinematics (ik): {} frames, {} coordinates; RMS orientation error per frame {:.3} deg mean, {:.3} max; {:.2} steps per frame (max {})",
+        s.frames,
+        s.coordinates.len(),
+        s.mean_rms_error_deg,
+        s.max_rms_error_deg,
+        s.mean_iterations,
+        s.max_iterations
+    );
+    if !s.pct_at_limit.is_empty() {
+        let list: Vec<String> = s
+            .pct_at_limit
+            .iter()
+            .map(|(c, p)| format!("{c} {p:.1}%"))
+            .collect();
+        let _ = writeln!(out, "frames on a hard limit: {}", list.join(", "));
+    }
 }

@@ -3,9 +3,12 @@
 //! to reproduce the output exactly.
 
 use crate::acm::{Correction, ImuHeading, JointResult, SkippedJoint, Variant};
+use crate::ik::output::{coordinates_path, write_coordinates};
+use crate::ik::IkSummary;
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
+use crate::pose::PoseRecord;
 use crate::save::atomic_write;
 use crate::trial::{write_trial, Trial, TrialFormat};
 use serde::{Deserialize, Serialize};
@@ -63,6 +66,20 @@ pub struct Sidecar {
     /// A functional calibration applied to the trial before the correction.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub calibration: Option<crate::calibration::AppliedCalibration>,
+    /// The pose calibration applied before the correction, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pose_calibration: Option<PoseRecord>,
+    /// The `ik` variant's figures and its joint-coordinates file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ik: Option<IkRecord>,
+}
+
+/// What an `ik` run wrote besides the orientations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IkRecord {
+    /// The joint-coordinates CSV.
+    pub coordinates_file: String,
+    pub summary: IkSummary,
 }
 
 /// Hex SHA-256 of bytes.
@@ -113,6 +130,8 @@ impl Sidecar {
             figures,
             warnings: Vec::new(),
             calibration: None,
+            pose_calibration: None,
+            ik: None,
         }
     }
 
@@ -176,8 +195,10 @@ pub struct SaveRequest<'a> {
     /// The file the raw trial was read from.
     pub input: &'a Path,
     pub input_format: TrialFormat,
-    /// The raw trial as read.
+    /// The trial as the correction saw it: as read, or pose-calibrated.
     pub trial: &'a Trial,
+    /// The pose calibration that made `trial` from the file, if any.
+    pub pose: Option<&'a PoseRecord>,
     pub correction: &'a Correction,
     pub model: &'a Model,
     pub limits: &'a LimitTable,
@@ -223,6 +244,11 @@ impl SaveRequest<'_> {
             figures,
         );
         s.warnings = self.trial.warnings.clone();
+        s.pose_calibration = self.pose.cloned();
+        s.ik = self.correction.ik.as_ref().map(|run| IkRecord {
+            coordinates_file: coordinates_path(self.output).display().to_string(),
+            summary: run.summary(),
+        });
         Ok(s)
     }
 
@@ -240,6 +266,9 @@ impl SaveRequest<'_> {
                 .map_err(|e| anyhow::anyhow!("{}: cannot create folder: {e}", dir.display()))?;
         }
         write_trial(&self.correction.corrected, self.output, self.output_format)?;
+        if let Some(run) = &self.correction.ik {
+            write_coordinates(run, &coordinates_path(self.output))?;
+        }
         let path = self
             .sidecar
             .map(Path::to_path_buf)

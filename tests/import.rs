@@ -218,6 +218,11 @@ fn xsens_exports_align_on_wrapped_counters_through_the_mapping() {
         "{w}"
     );
     assert!(w.contains("3 packets missing (3 from packet 65540)"), "{w}");
+    // The missing packets are a gap in time (4 intervals > 3), 0.07 s to 0.11 s.
+    let gaps = acm_workbench::trial::timing::timing(&trial.time_s).gaps;
+    assert_eq!(gaps.len(), 1, "{gaps:?}");
+    assert_eq!(gaps[0].index, 7);
+    assert!((gaps[0].from_s - 0.06).abs() < 1e-12 && (gaps[0].to_s - 0.10).abs() < 1e-12);
     assert_eq!(trial.warnings.len(), 2, "{w}");
 
     // The folder reads the same through the mapping in its parent.

@@ -39,6 +39,9 @@ pub fn correct_trial(
     variant: Variant,
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
+    if variant == Variant::Ik {
+        return crate::ik::correct_trial(trial, model, settings, control);
+    }
     run(trial, model, limits, settings, variant, None, control)
 }
 
@@ -54,6 +57,10 @@ pub fn recorrect(
     joints: &[&str],
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
+    if previous.variant == Variant::Ik {
+        // Inverse kinematics does not read the limit table or the settings.
+        return Ok(previous.clone());
+    }
     let mut redo = BTreeSet::new();
     for (k, j) in model.joints.iter().enumerate() {
         if joints.contains(&j.name.as_str()) {
@@ -241,6 +248,7 @@ fn run(
         corrected,
         joints: joints.into_iter().map(|(_, r)| r).collect(),
         skipped,
+        ik: None,
     })
 }
 

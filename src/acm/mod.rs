@@ -52,18 +52,22 @@ pub enum Variant {
     DriftHeading,
     /// As `drift-heading`, with the centroid term.
     DriftHeadingCentroid,
+    /// IMU inverse kinematics (`crate::ik`): joint coordinates with the
+    /// model's degrees of freedom and hard limits; not the ACM.
+    Ik,
 }
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 7] = [
+    pub const ALL: [Variant; 8] = [
         Variant::Basic,
         Variant::Drift,
         Variant::DriftCentroid,
-        Variant::Rivest,
-        Variant::Mueller,
         Variant::DriftHeading,
         Variant::DriftHeadingCentroid,
+        Variant::Rivest,
+        Variant::Mueller,
+        Variant::Ik,
     ];
 
     /// The name used on the command line, in files and on screen.
@@ -76,6 +80,7 @@ impl Variant {
             Variant::Mueller => "mueller",
             Variant::DriftHeading => "drift-heading",
             Variant::DriftHeadingCentroid => "drift-heading-centroid",
+            Variant::Ik => "ik",
         }
     }
 
@@ -86,7 +91,7 @@ impl Variant {
 
     /// Solves per window (true) or once for the whole trial (false).
     pub fn windowed(self) -> bool {
-        !matches!(self, Variant::Basic)
+        !matches!(self, Variant::Basic | Variant::Ik)
     }
 
     /// Uses the table's centroid term.
@@ -235,6 +240,8 @@ pub struct Correction {
     /// Estimated heading drift per corrected IMU, in model order (heading-drift
     /// variants only; empty otherwise).
     pub headings: Vec<ImuHeading>,
+    /// The joint coordinates of the `ik` variant (None for the others).
+    pub ik: Option<std::sync::Arc<crate::ik::IkRun>>,
 }
 
 impl Correction {

@@ -5,9 +5,22 @@
 //! Angles are the joints' Z-Y-X Euler angles `[x, y, z]` in degrees (distal
 //! relative to proximal, as [`crate::metrics::joint_angles`] gives them); times
 //! are seconds from each trial's first sample.
+//!
+//! The views of one trial, as numbers (thesis 4.1-4.5, appendices B-C):
+//!
+//! * [`scatter`]: limit classes of joint angles and their 3-D scatter as three
+//!   projections, reduced to a raster of the display's resolution;
+//! * [`globe`]: the globographic mapping (the distal segment's direction on a
+//!   sphere around the joint) and its limit band;
+//! * [`applied`]: the applied correction over time;
+//! * [`stick`]: the stick figure from segment orientations and lengths.
 
+pub mod applied;
 pub mod centroid;
+pub mod globe;
 pub mod histogram;
+pub mod scatter;
+pub mod stick;
 pub mod suggest;
 
 use crate::limits::LimitTable;

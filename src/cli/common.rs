@@ -1,8 +1,10 @@
 //! What several commands share: model, limits and settings resolution, progress.
 
 use acm_workbench::limits::{LimitTable, LimitsDir, Settings};
-use acm_workbench::model::Model;
+use acm_workbench::model::{Model, SignedAxis};
+use acm_workbench::pose::{calibrate, PoseCalibration, PoseRecord, PoseTime};
 use acm_workbench::trial::detect_model;
+use acm_workbench::trial::Trial;
 use clap::Args;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -35,6 +37,49 @@ pub struct EngineArgs {
     /// Worker threads [default: all cores]; results do not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
+}
+
+/// Pose calibration before the correction (shared by `correct` and `report`).
+#[derive(Debug, Clone, Args, Default)]
+pub struct PoseArgs {
+    /// Pose calibration with heading correction before correcting: the
+    /// subject holds the model's default pose at TIME, or over START..END
+    /// (seconds from the first sample; orientations averaged).
+    #[arg(long, value_name = "TIME|START..END")]
+    pub pose_calibration: Option<PoseTime>,
+    /// The base IMU's sensor axis that points forward in the calibration pose
+    /// (+x, -x, +y, -y, +z, -z) [default: the model's `pose.base_forward`].
+    #[arg(long, value_name = "AXIS", requires = "pose_calibration")]
+    pub base_forward: Option<SignedAxis>,
+}
+
+impl PoseArgs {
+    /// The calibration asked for, with the model's heading axes unless overridden.
+    pub fn calibration(&self, model: &Model) -> Option<PoseCalibration> {
+        let at = self.pose_calibration?;
+        let mut setup = model.pose;
+        if let Some(a) = self.base_forward {
+            setup.base_forward = a;
+        }
+        Some(PoseCalibration { at, setup })
+    }
+}
+
+/// `trial` pose-calibrated as `calibration` asks (unchanged without one).
+pub fn apply_pose(
+    trial: Trial,
+    model: &Model,
+    calibration: Option<&PoseCalibration>,
+    file: &Path,
+) -> anyhow::Result<(Trial, Option<PoseRecord>)> {
+    match calibration {
+        None => Ok((trial, None)),
+        Some(c) => {
+            let (t, r) = calibrate(&trial, model, c)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+            Ok((t, Some(r)))
+        }
+    }
 }
 
 /// Sizes the global worker pool (all cores when `None`). Results do not

@@ -1,7 +1,10 @@
 //! `acmw correct`: correct a trial, write the corrected trial and its sidecar.
 
-use super::common::{load_context, set_threads, Context, EngineArgs, Progress};
+use super::common::{
+    apply_pose, load_context, set_threads, Context, EngineArgs, PoseArgs, Progress,
+};
 use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::ik::output::coordinates_path;
 use acm_workbench::sidecar::{default_output, SaveRequest, Sidecar};
 use acm_workbench::trial::{detect_format, read_trial, TrialFormat};
 use clap::Args;
@@ -25,13 +28,15 @@ pub struct CorrectArgs {
     pub sidecar: Option<PathBuf>,
     /// Take variant, settings, model and limit table from an earlier sidecar
     /// (reproduces that run exactly).
-    #[arg(long, conflicts_with_all = ["variant", "model", "limits", "lambda1", "window", "hop"])]
+    #[arg(long, conflicts_with_all = ["variant", "model", "limits", "lambda1", "window", "hop", "pose_calibration"])]
     pub from_sidecar: Option<PathBuf>,
     /// Apply this functional calibration (`acmw calibrate`) to the trial first.
     #[arg(long, conflicts_with = "from_sidecar")]
     pub calibration: Option<PathBuf>,
     #[command(flatten)]
     pub engine: EngineArgs,
+    #[command(flatten)]
+    pub pose: PoseArgs,
     /// No progress or summary output.
     #[arg(short, long)]
     pub quiet: bool,
@@ -40,7 +45,7 @@ pub struct CorrectArgs {
 /// Runs `acmw correct`.
 pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     let mut recorded_calibration = None;
-    let (ctx, variant) = match &args.from_sidecar {
+    let (ctx, variant, pose) = match &args.from_sidecar {
         Some(p) => {
             let s = Sidecar::load(p)?;
             recorded_calibration = s
@@ -56,9 +61,14 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
                 limits_source: s.limits.source.clone(),
                 settings: s.settings,
             };
-            (ctx, s.variant)
+            let pose = s.pose_calibration.as_ref().map(|p| p.calibration);
+            (ctx, s.variant, pose)
         }
-        None => (load_context(&args.engine, Some(&args.input))?, args.variant),
+        None => {
+            let ctx = load_context(&args.engine, Some(&args.input))?;
+            let pose = args.pose.calibration(&ctx.model);
+            (ctx, args.variant, pose)
+        }
     };
     let (in_format, gzip) = detect_format(&args.input)?;
     let mut trial = read_trial(&args.input, &ctx.model)?;
@@ -78,6 +88,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             args.quiet,
         )?,
     };
+    let (trial, pose) = apply_pose(trial, &ctx.model, pose.as_ref(), &args.input)?;
     if !args.quiet {
         for w in &trial.warnings {
             eprintln!("warning: {w}");
@@ -107,6 +118,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         input: &args.input,
         input_format: in_format,
         trial: &trial,
+        pose: pose.as_ref(),
         correction: &correction,
         model: &ctx.model,
         limits: &ctx.limits,
@@ -122,13 +134,35 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         for s in &correction.skipped {
             eprintln!("skipped {}: {}", s.joint, s.reason);
         }
-        println!(
-            "{}: {variant}, {} joints corrected -> {} (sidecar {})",
-            trial.name,
-            correction.joints.len(),
-            output.display(),
-            sc_path.display()
-        );
+        if let Some(p) = &pose {
+            println!(
+                "{}: pose calibration at {} s ({} samples), heading correction {:.2} deg",
+                trial.name, p.calibration.at, p.samples, p.heading_deg
+            );
+        }
+        match &correction.ik {
+            Some(run) => {
+                let s = run.summary();
+                println!(
+                    "{}: ik, {} coordinates, RMS orientation error {:.3} deg (max {:.3}), {:.1} steps per frame -> {} and {} (sidecar {})",
+                    trial.name,
+                    s.coordinates.len(),
+                    s.mean_rms_error_deg,
+                    s.max_rms_error_deg,
+                    s.mean_iterations,
+                    output.display(),
+                    coordinates_path(&output).display(),
+                    sc_path.display()
+                );
+            }
+            None => println!(
+                "{}: {variant}, {} joints corrected -> {} (sidecar {})",
+                trial.name,
+                correction.joints.len(),
+                output.display(),
+                sc_path.display()
+            ),
+        }
     }
     Ok(0)
 }

@@ -13,6 +13,7 @@ mod calibrate;
 mod common;
 mod correct;
 mod plot;
+mod plot_views;
 mod render;
 mod report;
 mod simulate;

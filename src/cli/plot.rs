@@ -33,9 +33,12 @@ pub struct PlotArgs {
     /// Correction variant drawn beside the uncorrected angles (`traces`).
     #[arg(long, value_enum, default_value_t = Variant::DriftCentroid)]
     pub variant: Variant,
-    /// Draw the uncorrected angles only (`traces`; no correction is run).
+    /// Draw the uncorrected angles only (`traces`, `scatter`, `globe`; no correction is run).
     #[arg(long)]
     pub uncorrected: bool,
+    /// Colour points by time instead of by limit class (`scatter`, `globe`).
+    #[arg(long)]
+    pub time_colour: bool,
     /// Size in pixels, WxH.
     #[arg(long, default_value = "1200x800", value_parser = super::render::parse_size)]
     pub size: (u16, u16),
@@ -58,6 +61,8 @@ pub fn run(a: PlotArgs) -> anyhow::Result<i32> {
     match a.kind {
         PlotKind::Traces => traces(&a, &ctx, &trials[0], size)?,
         PlotKind::Histogram => histogram(&a, &ctx, &trials, size)?,
+        PlotKind::Scatter => super::plot_views::scatter(&a, &ctx, &trials[0], size)?,
+        PlotKind::Globe => super::plot_views::globe(&a, &ctx, &trials[0], size)?,
     }
     println!("wrote {}", a.output.display());
     Ok(super::EXIT_OK)
@@ -76,7 +81,21 @@ fn joint_name(a: &PlotArgs, ctx: &Context) -> anyhow::Result<String> {
     }
 }
 
-fn traces(a: &PlotArgs, ctx: &Context, trial: &Trial, size: (u32, u32)) -> anyhow::Result<()> {
+/// One joint's angles, uncorrected and (unless `--uncorrected`) corrected
+/// with the variant asked for, Z-Y-X degrees per sample.
+pub struct JointSeries<'m> {
+    pub joint: &'m acm_workbench::model::Joint,
+    pub raw: Vec<[f64; 3]>,
+    /// The variant's name and the corrected angles.
+    pub corrected: Option<(String, Vec<[f64; 3]>)>,
+}
+
+/// The angles of the joint asked for in `trial`.
+pub fn joint_series<'m>(
+    a: &PlotArgs,
+    ctx: &'m Context,
+    trial: &Trial,
+) -> anyhow::Result<JointSeries<'m>> {
     let name = joint_name(a, ctx)?;
     let joint = ctx
         .model
@@ -98,6 +117,20 @@ fn traces(a: &PlotArgs, ctx: &Context, trial: &Trial, size: (u32, u32)) -> anyho
         )?;
         joint_angles(&c.corrected, joint).map(|v| (a.variant.name().to_string(), v))
     };
+    Ok(JointSeries {
+        joint,
+        raw,
+        corrected,
+    })
+}
+
+fn traces(a: &PlotArgs, ctx: &Context, trial: &Trial, size: (u32, u32)) -> anyhow::Result<()> {
+    let JointSeries {
+        joint,
+        raw,
+        corrected,
+    } = joint_series(a, ctx, trial)?;
+    let name = joint.name.clone();
     let span = a.span.span(f64::INFINITY)?;
     let end = span.end_s.min(trial.duration_s());
     if end <= span.start_s {

@@ -1,6 +1,6 @@
 //! `acmw report`: the METHOD.md section 6 figures before and after each variant.
 
-use super::common::{load_context, EngineArgs, Progress};
+use super::common::{apply_pose, load_context, EngineArgs, PoseArgs, Progress};
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::report::{format_text, ReportInput};
 use acm_workbench::trial::read_trial;
@@ -15,6 +15,10 @@ pub struct ReportArgs {
     /// Variants to run and compare (repeatable) [default: all].
     #[arg(long, value_enum)]
     pub variant: Vec<Variant>,
+    /// Flag orientation jumps larger than this between neighbouring samples,
+    /// degrees [default: 30].
+    #[arg(long, value_parser = positive_deg)]
+    pub glitch_deg: Option<f64>,
     /// Print JSON instead of text tables.
     #[arg(long)]
     pub json: bool,
@@ -23,9 +27,21 @@ pub struct ReportArgs {
     pub calibration: Option<PathBuf>,
     #[command(flatten)]
     pub engine: EngineArgs,
+    #[command(flatten)]
+    pub pose: PoseArgs,
     /// No progress output.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// A positive, finite angle in degrees.
+fn positive_deg(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "expected a positive number of degrees, found '{s}'"
+        )),
+    }
 }
 
 /// Runs `acmw report`.
@@ -38,6 +54,8 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         &ctx.model,
         args.quiet,
     )?;
+    let pose_calibration = args.pose.calibration(&ctx.model);
+    let (trial, pose) = apply_pose(trial, &ctx.model, pose_calibration.as_ref(), &args.input)?;
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {
             let t = t?;
@@ -70,7 +88,11 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         settings: &ctx.settings,
         truth: truth.as_ref().map(|t| &t.segments),
     };
-    let r = input.run(&variants, &control)?;
+    let mut r = input.run(&variants, &control)?;
+    r.pose_calibration = pose;
+    if let Some(deg) = args.glitch_deg {
+        r.set_glitch_threshold(&trial, deg);
+    }
     progress.finish();
     if args.json {
         println!("{}", serde_json::to_string_pretty(&r)?);

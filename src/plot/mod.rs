@@ -8,7 +8,9 @@
 //! viewer's font draws it).
 
 pub mod envelope;
+pub mod globe;
 pub mod histogram;
+pub mod scatter;
 pub mod traces;
 
 use plotters::coord::Shift;
@@ -24,6 +26,12 @@ pub enum PlotKind {
     /// Histograms of a joint's angles over trials with the limits, the mean
     /// and the 90% interval, as the thesis' Figures 3-3 to 3-6 ([`histogram`]).
     Histogram,
+    /// A joint's Z-Y-X angles as three projections, points coloured by limit
+    /// class or time, uncorrected beside corrected ([`scatter`]).
+    Scatter,
+    /// The distal segment's direction on a sphere around the joint with the
+    /// limit band, as the thesis' Figure 4-5 ([`globe`]).
+    Globe,
 }
 
 /// Output format.

@@ -9,8 +9,10 @@ use crate::rotation::Quat;
 use serde::{Deserialize, Serialize};
 
 mod error;
+pub mod glitch;
 mod io;
 pub mod mapping;
+pub mod timing;
 pub mod xsens;
 pub mod xsens_trial;
 
@@ -92,9 +94,11 @@ impl Trial {
         median_dt(&self.time_s)
     }
 
-    /// Trial length `T = n * dt` with dt the median sample interval (METHOD.md section 4).
+    /// Trial length, seconds: `T = n * dt` with dt the median sample interval
+    /// (METHOD.md section 4), or with gaps the span of the times plus one
+    /// interval ([`timing::trial_length_s`]).
     pub fn duration_s(&self) -> f64 {
-        self.len() as f64 * self.median_dt()
+        timing::trial_length_s(&self.time_s)
     }
 
     /// Nominal sampling rate in Hz (1 / median interval; 0 when unknown).

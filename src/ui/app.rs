@@ -50,6 +50,12 @@ pub struct Loaded {
     pub before: Vec<JointFigures>,
     /// Joint angles of the uncorrected trial, filled on demand.
     pub angles: AngleCache,
+    /// The pose calibration `trial` went through (None: as read).
+    pub pose: Option<crate::pose::PoseRecord>,
+    /// The trial as read, while `trial` is pose-calibrated.
+    pub uncalibrated: Option<Arc<Loaded>>,
+    /// Orientation jumps over the default threshold, by time (key `G`).
+    pub glitches: Vec<crate::trial::glitch::Glitch>,
 }
 
 /// Whether a trial is read yet.
@@ -153,6 +159,8 @@ pub enum Screen {
     Trial,
     Compare,
     Limits,
+    /// The analysis views (`super::views`).
+    Views,
     Calibration,
     Histogram,
 }
@@ -409,6 +417,8 @@ pub struct App {
     /// A message in the status bar: (text, is_error).
     pub message: Option<(String, bool)>,
     pub quit: bool,
+    /// State of the analysis views.
+    pub views: super::views::ViewsState,
     /// The calibration screen (`super::calibration`).
     pub calib: super::calibration::CalibState,
     /// The histogram screen, once opened.
@@ -454,6 +464,13 @@ pub enum Effect {
     /// Ask for `Msg::RecorrectDue` after the debounce delay (a newer request
     /// replaces an older one).
     Debounce,
+    /// Pose-calibrate a loaded trial (answered by `Msg::PoseCalibrated`).
+    PoseCalibrate {
+        file: String,
+        loaded: Arc<Loaded>,
+        calibration: crate::pose::PoseCalibration,
+        limits: LimitTable,
+    },
 }
 
 /// A correction job.
@@ -499,10 +516,14 @@ pub enum Msg {
     /// The limit files on disk differ from what the workbench last loaded or saved.
     LimitsOnDisk(LimitTable, SettingsFile),
     RecorrectDue,
+    /// Time passes (only sent while something plays).
+    Tick,
     /// The calibration recordings of the folder, read and calibrated (protocol label).
     Calibrations(Vec<super::calibration::CalibEntry>, String),
     /// A suggested limit table or a centroid table was written (its path), or why not.
     TableWritten(Result<String, String>),
+    /// A pose-calibrated version of a trial, or why there is none.
+    PoseCalibrated(String, Result<Arc<Loaded>, String>),
 }
 
 impl App {
@@ -529,6 +550,7 @@ impl App {
             limits_from: Screen::Trials,
             message: None,
             quit: false,
+            views: Default::default(),
             calib: Default::default(),
             histogram: None,
         };
@@ -568,7 +590,7 @@ impl App {
         self.trials.iter().find(|t| t.file == file)
     }
 
-    fn entry_mut(&mut self, file: &str) -> Option<&mut TrialEntry> {
+    pub(super) fn entry_mut(&mut self, file: &str) -> Option<&mut TrialEntry> {
         self.trials.iter_mut().find(|t| t.file == file)
     }
 
@@ -616,11 +638,11 @@ impl App {
         }
     }
 
-    fn info(&mut self, text: impl Into<String>) {
+    pub(super) fn info(&mut self, text: impl Into<String>) {
         self.message = Some((text.into(), false));
     }
 
-    fn error(&mut self, text: impl Into<String>) {
+    pub(super) fn error(&mut self, text: impl Into<String>) {
         self.message = Some((text.into(), true));
     }
 
@@ -632,7 +654,11 @@ impl App {
         l.before.iter().map(|f| f.joint.clone()).collect()
     }
 
-    fn run_effect(&mut self, file: &str, recorrect: Option<Vec<String>>) -> Option<Effect> {
+    pub(super) fn run_effect(
+        &mut self,
+        file: &str,
+        recorrect: Option<Vec<String>>,
+    ) -> Option<Effect> {
         let limits = self.limits.table.clone();
         let limits_source = self.limits.source.clone();
         let settings = self.settings;
@@ -824,6 +850,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
         }
         Msg::RecorrectDue => recorrect_now(app),
+        Msg::Tick => {
+            super::views::tick(app);
+            vec![]
+        }
         Msg::Calibrations(entries, protocol) => {
             super::calibration::loaded(app, entries, protocol);
             vec![]
@@ -832,6 +862,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             super::histogram::written(app, result);
             vec![]
         }
+        Msg::PoseCalibrated(file, result) => super::pose::calibrated(app, &file, result),
     }
 }
 
@@ -1053,6 +1084,10 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Trial => trial_action(app, a),
         Screen::Compare => compare_action(app, a),
         Screen::Limits => limits_action(app, a),
+        Screen::Views => {
+            super::views::action(app, a);
+            vec![]
+        }
         Screen::Calibration => super::calibration::action(app, a),
         Screen::Histogram => super::histogram::action(app, a),
     }
@@ -1117,7 +1152,7 @@ pub fn open(app: &mut App, file: String) {
     app.screen = Screen::Trial;
 }
 
-fn next_variant(app: &mut App) {
+pub(super) fn next_variant(app: &mut App) {
     let k = Variant::ALL
         .iter()
         .position(|v| *v == app.variant)
@@ -1146,7 +1181,13 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::Home => app.view.cursor_s = 0.0,
         Action::End => app.view.cursor_s = d,
         Action::Marker => app.view.braille = !app.view.braille,
+        Action::NextGlitch => next_glitch(app),
         Action::Variant => next_variant(app),
+        Action::Pose => return super::pose::toggle(app),
+        Action::Scatter => super::views::open(app, super::views::ViewKind::Scatter),
+        Action::Globe => super::views::open(app, super::views::ViewKind::Globe),
+        Action::Applied => super::views::open(app, super::views::ViewKind::Applied),
+        Action::Stick => super::views::open(app, super::views::ViewKind::Stick),
         Action::Compare => {
             app.compare_col = Variant::ALL
                 .iter()
@@ -1164,7 +1205,7 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
     // Keep the cursor in view when it moved.
     if matches!(
         a,
-        Action::CursorLeft | Action::CursorRight | Action::Home | Action::End
+        Action::CursorLeft | Action::CursorRight | Action::Home | Action::End | Action::NextGlitch
     ) {
         let (s0, s1) = app.view.span(d);
         let w = s1 - s0;
@@ -1174,6 +1215,20 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         }
     }
     vec![]
+}
+
+/// Moves the cursor to the selected joint's next glitch (wrapping).
+fn next_glitch(app: &mut App) {
+    let Some(l) = app.open_entry().and_then(|e| e.loaded()) else {
+        return;
+    };
+    let Some(joint) = l.before.get(app.joint).map(|f| f.joint.clone()) else {
+        return;
+    };
+    let found = super::glitches::of_joint(l, &joint);
+    if let Some(t) = super::glitches::next_after(&found, app.view.cursor_s) {
+        app.view.cursor_s = t;
+    }
 }
 
 fn compare_action(app: &mut App, a: Action) -> Vec<Effect> {

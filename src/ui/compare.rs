@@ -17,6 +17,15 @@ fn rms(f: &JointFigures) -> Option<f64> {
         .map(|t| (t.rms_error_deg.iter().map(|x| x * x).sum::<f64>() / 3.0).sqrt())
 }
 
+/// A variant's name in a 14-character column (the status list below the
+/// table spells every name out).
+fn column_label(v: Variant) -> &'static str {
+    match v {
+        Variant::DriftHeadingCentroid => "drift-hdg-cent",
+        v => v.name(),
+    }
+}
+
 pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(e) = app.open_entry() else {
         f.render_widget(Paragraph::new("no trial open"), area);
@@ -55,10 +64,11 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         .skip(cols.start)
         .take(cols.len())
     {
-        let mut name = v.name().to_string();
+        let mut name = column_label(*v).to_string();
         if e.chosen == Some(*v) {
             name = format!("*{name}");
         }
+        let name = fit(&name, cw.max(15) - 1).trim_end().to_string();
         let style = if k == app.compare_col {
             theme.selected.patch(theme.header)
         } else {

@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The screens `acmw render` knows.
-pub const SCREENS: [&str; 7] = [
+pub const SCREENS: [&str; 11] = [
     "trials",
     "trial",
     "compare",
@@ -23,6 +23,10 @@ pub const SCREENS: [&str; 7] = [
     "help",
     "calibration",
     "histogram",
+    "scatter",
+    "globe",
+    "applied",
+    "stick",
 ];
 
 /// A workbench over `dir` (shown as `dir_label`) with every trial read.
@@ -65,7 +69,7 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
                 super::app::LoadState::Failed(m) => Some(m.clone()),
                 _ => None,
             } {
-                if matches!(s.screen.as_str(), "trial" | "compare") {
+                if !matches!(s.screen.as_str(), "trials" | "limits" | "help") {
                     return Err(m);
                 }
             }
@@ -81,7 +85,7 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
         app.select_file(t);
     }
     match s.screen.as_str() {
-        "trial" | "compare" => {
+        "trial" | "compare" | "scatter" | "globe" | "applied" | "stick" => {
             let t = trial.ok_or("no trial could be read")?;
             open(app, t.clone());
             if let Some(j) = &s.joint {
@@ -103,6 +107,9 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
             app.message = None;
             if s.screen == "compare" {
                 app.screen = Screen::Compare;
+            }
+            if let Some(kind) = super::views::ViewKind::from_name(&s.screen) {
+                super::views::open(app, kind);
             }
         }
         "limits" => app.screen = Screen::Limits,

@@ -8,6 +8,7 @@ use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
 use crate::report::ReportInput;
 use crate::sidecar::{default_output, SaveRequest};
+use crate::trial::glitch::{glitches, DEFAULT_GLITCH_DEG};
 use crate::trial::xsens_trial::{is_mapping_file, resolve};
 use crate::trial::{detect_format, detect_model, is_trial_path, read_trial, TrialError};
 use crate::truth::load_truth_beside;
@@ -94,7 +95,9 @@ pub fn load_trial(file: &str, path: &Path, limits: &LimitTable) -> Msg {
             Some(Err(e)) => (None, Some(shown(e))),
         };
         let before = trial_figures(&trial, None, truth.as_ref(), &model, limits);
+        let glitches = glitches(&trial, DEFAULT_GLITCH_DEG);
         Ok(Arc::new(Loaded {
+            glitches,
             trial,
             model,
             format,
@@ -103,6 +106,8 @@ pub fn load_trial(file: &str, path: &Path, limits: &LimitTable) -> Msg {
             truth_error,
             before,
             angles: Default::default(),
+            pose: None,
+            uncalibrated: None,
         }))
     })();
     Msg::Loaded(file.to_string(), result)
@@ -184,6 +189,7 @@ pub fn save_variant(
         input: path,
         input_format: loaded.format,
         trial: &loaded.trial,
+        pose: loaded.pose.as_ref(),
         correction,
         model: &loaded.model,
         limits,
@@ -264,6 +270,17 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
             &path,
             original.as_deref(),
             &csv,
+        )],
+        Effect::PoseCalibrate {
+            file,
+            loaded,
+            calibration,
+            limits,
+        } => vec![super::pose::calibrate_job(
+            &file,
+            &loaded,
+            &calibration,
+            &limits,
         )],
     }
 }

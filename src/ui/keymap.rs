@@ -32,10 +32,18 @@ pub enum Action {
     Save,
     Choose,
     Marker,
+    Pose,
+    NextGlitch,
     KeepMine,
     TakeFile,
     Yes,
     No,
+    Scatter,
+    Globe,
+    Applied,
+    Stick,
+    Play,
+    TimeColour,
 }
 
 /// Where a binding applies, for the help overlay.
@@ -46,6 +54,7 @@ pub enum Scope {
     Trial,
     Compare,
     Limits,
+    Views,
 }
 
 impl Scope {
@@ -56,6 +65,7 @@ impl Scope {
             Scope::Trial => "trial",
             Scope::Compare => "compare",
             Scope::Limits => "limits",
+            Scope::Views => "views",
         }
     }
 }
@@ -97,10 +107,18 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "Home/End", code: &[KeyCode::Home], action: Action::Home, scope: Scope::Trial, help: "cursor to start / end" },
     Binding { keys: "", code: &[KeyCode::End], action: Action::End, scope: Scope::Trial, help: "" },
     Binding { keys: "m", code: &[KeyCode::Char('m')], action: Action::Marker, scope: Scope::Trial, help: "braille / dot marker" },
+    Binding { keys: "P", code: &[KeyCode::Char('P')], action: Action::Pose, scope: Scope::Trial, help: "pose calibration at cursor" },
+    Binding { keys: "G", code: &[KeyCode::Char('G')], action: Action::NextGlitch, scope: Scope::Trial, help: "cursor to the next glitch" },
     Binding { keys: "Space", code: &[KeyCode::Char(' ')], action: Action::Choose, scope: Scope::Compare, help: "choose the variant" },
     Binding { keys: "w", code: &[KeyCode::Char('w')], action: Action::Save, scope: Scope::Everywhere, help: "save variant / limits" },
     Binding { keys: "K / T", code: &[KeyCode::Char('K')], action: Action::KeepMine, scope: Scope::Limits, help: "reload: mine / file's" },
     Binding { keys: "", code: &[KeyCode::Char('T')], action: Action::TakeFile, scope: Scope::Limits, help: "" },
+    Binding { keys: "x", code: &[KeyCode::Char('x')], action: Action::Scatter, scope: Scope::Trial, help: "3-D scatter view" },
+    Binding { keys: "o", code: &[KeyCode::Char('o')], action: Action::Globe, scope: Scope::Trial, help: "globographic view" },
+    Binding { keys: "a", code: &[KeyCode::Char('a')], action: Action::Applied, scope: Scope::Trial, help: "applied correction view" },
+    Binding { keys: "f", code: &[KeyCode::Char('f')], action: Action::Stick, scope: Scope::Trial, help: "stick figure view" },
+    Binding { keys: "t", code: &[KeyCode::Char('t')], action: Action::TimeColour, scope: Scope::Views, help: "colour by time / limits" },
+    Binding { keys: "p", code: &[KeyCode::Char('p')], action: Action::Play, scope: Scope::Views, help: "play / pause (or Space)" },
     Binding { keys: "y / n", code: &[KeyCode::Char('y')], action: Action::Yes, scope: Scope::Everywhere, help: "answer a question" },
     Binding { keys: "", code: &[KeyCode::Char('n')], action: Action::No, scope: Scope::Everywhere, help: "" },
 ];

@@ -4,7 +4,7 @@
 use super::app::{App, Overlay, Screen};
 use super::keymap::{help_lines, Scope};
 use super::theme::Theme;
-use super::{compare, limits, trial, trials};
+use super::{compare, limits, trial, trials, views};
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Style;
 use ratatui::text::{Line, Span};
@@ -33,6 +33,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
         Screen::Trial => trial::render(app, theme, f, body),
         Screen::Compare => compare::render(app, theme, f, body),
         Screen::Limits => limits::render(app, theme, f, body),
+        Screen::Views => views::render(app, theme, f, body),
         Screen::Calibration => super::calibration::render(app, theme, f, body),
         Screen::Histogram => super::histogram::render(app, theme, f, body),
     }
@@ -51,6 +52,11 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         Screen::Trial => format!("Trial {}", app.open.as_deref().unwrap_or("")),
         Screen::Compare => format!("Compare {}", app.open.as_deref().unwrap_or("")),
         Screen::Limits => "Limits".to_string(),
+        Screen::Views => format!(
+            "{} {}",
+            app.views.kind.name(),
+            app.open.as_deref().unwrap_or("")
+        ),
         Screen::Calibration => "Calibration".to_string(),
         Screen::Histogram => "Histograms".to_string(),
     };
@@ -84,10 +90,11 @@ pub fn hints(app: &App) -> &'static str {
             "Enter open  r run  / filter  s sort  v variant  l limits  ? help  q quit"
         }
         Screen::Trial => {
-            "r run  v variant  c compare  +- zoom  <- -> pan  , . cursor  l limits  ? help"
+            "r run  v variant  c compare  +- zoom  <- -> pan  , . cursor  x o a f views  ? help"
         }
         Screen::Compare => "<- -> variant  Space choose  w save  r run  Esc back  ? help",
         Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
+        Screen::Views => "x scatter  o globe  a applied  f stick  t time colour  Esc back  ? help",
         Screen::Calibration => "Up/Down recording  r read again  Esc back  ? help  q quit",
         Screen::Histogram => {
             "Enter suggest  w centroids  <- -> span  +- length  Home 30 s  End all  Esc back"
@@ -138,13 +145,16 @@ fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
         Scope::Trial,
         Scope::Compare,
         Scope::Limits,
+        Scope::Views,
     ];
     let mut items: Vec<Line> = vec![];
+    let mut headings = vec![];
     for scope in order {
         let entries: Vec<_> = help_lines().into_iter().filter(|l| l.2 == scope).collect();
         if entries.is_empty() {
             continue;
         }
+        headings.push(items.len());
         items.push(Line::from(Span::styled(scope.title(), theme.header)));
         for (keys, text, _) in entries {
             items.push(Line::from(vec![
@@ -156,6 +166,13 @@ fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
     // Two columns when the list is taller than the screen.
     let inner_h = body.height.saturating_sub(3) as usize;
     let two = items.len() > inner_h && body.width >= 78;
+    // A heading never ends the left column: it moves to the right one.
+    if two {
+        let half = items.len().div_ceil(2);
+        if headings.contains(&(half - 1)) {
+            items.insert(half - 1, Line::default());
+        }
+    }
     let w = if two { 78 } else { 50 };
     let rows = if two {
         items.len().div_ceil(2)

@@ -285,13 +285,26 @@ fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
     for e in app.start() {
         workers.execute(e);
     }
+    let mut next_tick: Option<Instant> = None;
     loop {
-        let first = match workers.debounce {
+        // Ticks only while something plays; the debounce and the tick share the wait.
+        next_tick = crate::ui::views::wants_ticks(app)
+            .then(|| next_tick.unwrap_or_else(|| Instant::now() + crate::ui::views::TICK));
+        let wake = match (workers.debounce, next_tick) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        let first = match wake {
             Some(at) => match rx.recv_timeout(at.saturating_duration_since(Instant::now())) {
                 Ok(e) => e,
                 Err(crossbeam_channel::RecvTimeoutError::Timeout) => {
-                    workers.debounce = None;
-                    Event::Msg(Msg::RecorrectDue)
+                    if workers.debounce.is_some_and(|d| d <= Instant::now()) {
+                        workers.debounce = None;
+                        Event::Msg(Msg::RecorrectDue)
+                    } else {
+                        next_tick = None;
+                        Event::Msg(Msg::Tick)
+                    }
                 }
                 Err(_) => break,
             },

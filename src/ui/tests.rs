@@ -16,22 +16,22 @@ use std::path::Path;
 /// Sizes every screen is checked at.
 pub const SIZES: [(u16, u16); 2] = [(80, 24), (120, 40)];
 
-struct Fixture {
+pub(super) struct Fixture {
     tmp: tempfile::TempDir,
 }
 
 impl Fixture {
-    fn new() -> Fixture {
+    pub(super) fn new() -> Fixture {
         let tmp = tempfile::tempdir().unwrap();
         write_demo_folder(&tmp.path().join("trials")).unwrap();
         Fixture { tmp }
     }
 
-    fn root(&self) -> &Path {
+    pub(super) fn root(&self) -> &Path {
         self.tmp.path()
     }
 
-    fn app(&self) -> App {
+    pub(super) fn app(&self) -> App {
         load_app(
             "trials",
             &self.root().join("trials"),
@@ -41,23 +41,23 @@ impl Fixture {
     }
 }
 
-fn key(app: &mut App, c: KeyCode) {
+pub(super) fn key(app: &mut App, c: KeyCode) {
     SyncRunner::send(app, Msg::Key(KeyEvent::from(c)));
 }
 
-fn keys(app: &mut App, s: &str) {
+pub(super) fn keys(app: &mut App, s: &str) {
     for c in s.chars() {
         key(app, KeyCode::Char(c));
     }
 }
 
-fn terminal(app: &App, w: u16, h: u16) -> Terminal<TestBackend> {
+pub(super) fn terminal(app: &App, w: u16, h: u16) -> Terminal<TestBackend> {
     let mut t = Terminal::new(TestBackend::new(w, h)).unwrap();
     t.draw(|f| render(app, &Theme::default(), f)).unwrap();
     t
 }
 
-fn snap(name: &str, app: &App) {
+pub(super) fn snap(name: &str, app: &App) {
     for (w, h) in SIZES {
         let t = terminal(app, w, h);
         insta::assert_snapshot!(format!("{name}_{w}x{h}"), t.backend());
@@ -189,6 +189,51 @@ fn trial_flow_run_compare_save() {
     assert!(!app.unsaved());
     keys(&mut app, "q");
     assert!(app.quit);
+}
+
+#[test]
+fn pose_calibration_toggles_and_ik_shows() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    shown(&mut app, "trial", "fb.csv.gz");
+    for _ in 0..10 {
+        keys(&mut app, ".");
+    }
+    let cursor = app.view.cursor_s;
+    assert!(cursor > 0.0);
+    keys(&mut app, "P");
+    let e = app.open_entry().unwrap();
+    let l = e.loaded().unwrap();
+    let p = l.pose.as_ref().expect("calibrated");
+    // At the sample under the cursor (50 Hz).
+    let crate::pose::PoseTime::At(at) = p.calibration.at else {
+        panic!("a single instant")
+    };
+    assert!((at - cursor).abs() <= 0.01 && (at * 50.0 - (at * 50.0).round()).abs() < 1e-9);
+    assert!(l.uncalibrated.is_some());
+    // Every variant ran again on the calibrated trial.
+    assert_eq!(e.results.len(), Variant::ALL.len());
+    assert!(e
+        .results
+        .values()
+        .all(|r| r.correction.corrected.imus.len() == 13));
+    while app.variant != Variant::Ik {
+        keys(&mut app, "v");
+    }
+    let e = app.open_entry().unwrap();
+    assert!(e.results[&Variant::Ik].correction.ik.is_some());
+    snap("trial_pose_ik", &app);
+    // P again: back to the trial as read, corrected again.
+    keys(&mut app, "P");
+    let e = app.open_entry().unwrap();
+    assert!(e.loaded().unwrap().pose.is_none());
+    assert_eq!(e.results.len(), Variant::ALL.len());
+    // The knee trial has no base IMU: the calibration says why.
+    shown(&mut app, "trial", "knee.csv");
+    keys(&mut app, "P");
+    let (m, is_error) = app.message.clone().unwrap();
+    assert!(is_error && m.contains("base IMU"), "{m}");
+    assert!(app.open_entry().unwrap().loaded().unwrap().pose.is_none());
 }
 
 #[test]

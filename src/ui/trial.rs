@@ -111,6 +111,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let d = l.trial.duration_s();
     let (s0, s1) = app.view.span(d);
     let ci = index_at(t, app.view.cursor_s + origin);
+    let glitches = super::glitches::of_joint(l, &joint.name);
     let [charts, foot] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
     let parts = Layout::vertical([Constraint::Ratio(1, 3); 3]).split(charts);
     for axis in 0..3 {
@@ -149,6 +150,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                 span: (s0, s1),
                 cursor: app.view.cursor_s,
                 braille: app.view.braille,
+                glitches: super::glitches::markers(&glitches, &raw, axis, (s0, s1)),
             },
         );
     }
@@ -166,7 +168,17 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                 1u32 << app.view.zoom.min(16),
                 app.view.cursor_s
             )),
+            Span::styled(
+                super::glitches::footer(&glitches, app.view.cursor_s).unwrap_or_default(),
+                theme.warn,
+            ),
             Span::styled(status, theme.dim),
+            Span::styled(
+                super::pose::label(l)
+                    .map(|p| format!("  {p}"))
+                    .unwrap_or_default(),
+                theme.header,
+            ),
         ])),
         foot,
     );
@@ -193,6 +205,8 @@ struct ChartData<'a> {
     span: (f64, f64),
     cursor: f64,
     braille: bool,
+    /// Glitch markers `(time, angle)` of the joint's IMUs in view.
+    glitches: Vec<(f64, f64)>,
 }
 
 fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
@@ -252,6 +266,16 @@ fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
     sets.push(line(&raw, theme.raw, marker));
     if !cor.is_empty() {
         sets.push(line(&cor, theme.corrected, marker));
+    }
+    // Glitches last, as full blocks: a glyph of their own, not colour alone.
+    if !d.glitches.is_empty() {
+        sets.push(
+            Dataset::default()
+                .data(&d.glitches)
+                .graph_type(GraphType::Scatter)
+                .marker(Marker::Block)
+                .style(theme.warn),
+        );
     }
     let y_labels = if area.height >= 7 {
         vec![
