@@ -1188,6 +1188,7 @@ fn trial_action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::Globe => super::views::open(app, super::views::ViewKind::Globe),
         Action::Applied => super::views::open(app, super::views::ViewKind::Applied),
         Action::Stick => super::views::open(app, super::views::ViewKind::Stick),
+        Action::HeadingDrift => super::views::open(app, super::views::ViewKind::Heading),
         Action::Compare => {
             app.compare_col = Variant::ALL
                 .iter()

@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The screens `acmw render` knows.
-pub const SCREENS: [&str; 11] = [
+pub const SCREENS: [&str; 12] = [
     "trials",
     "trial",
     "compare",
@@ -27,6 +27,7 @@ pub const SCREENS: [&str; 11] = [
     "globe",
     "applied",
     "stick",
+    "heading",
 ];
 
 /// A workbench over `dir` (shown as `dir_label`) with every trial read.
@@ -85,7 +86,7 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
         app.select_file(t);
     }
     match s.screen.as_str() {
-        "trial" | "compare" | "scatter" | "globe" | "applied" | "stick" => {
+        "trial" | "compare" | "scatter" | "globe" | "applied" | "stick" | "heading" => {
             let t = trial.ok_or("no trial could be read")?;
             open(app, t.clone());
             if let Some(j) = &s.joint {

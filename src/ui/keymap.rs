@@ -42,6 +42,7 @@ pub enum Action {
     Globe,
     Applied,
     Stick,
+    HeadingDrift,
     Play,
     TimeColour,
 }
@@ -117,6 +118,7 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "o", code: &[KeyCode::Char('o')], action: Action::Globe, scope: Scope::Trial, help: "globographic view" },
     Binding { keys: "a", code: &[KeyCode::Char('a')], action: Action::Applied, scope: Scope::Trial, help: "applied correction view" },
     Binding { keys: "f", code: &[KeyCode::Char('f')], action: Action::Stick, scope: Scope::Trial, help: "stick figure view" },
+    Binding { keys: "D", code: &[KeyCode::Char('D')], action: Action::HeadingDrift, scope: Scope::Trial, help: "heading drift per IMU" },
     Binding { keys: "t", code: &[KeyCode::Char('t')], action: Action::TimeColour, scope: Scope::Views, help: "colour by time / limits" },
     Binding { keys: "p", code: &[KeyCode::Char('p')], action: Action::Play, scope: Scope::Views, help: "play / pause (or Space)" },
     Binding { keys: "y / n", code: &[KeyCode::Char('y')], action: Action::Yes, scope: Scope::Everywhere, help: "answer a question" },

@@ -15,6 +15,7 @@ pub mod calibration;
 pub mod compare;
 pub mod glitches;
 pub mod globe;
+pub mod heading;
 pub mod headless;
 pub mod histogram;
 pub mod jobs;

@@ -90,11 +90,13 @@ pub fn hints(app: &App) -> &'static str {
             "Enter open  r run  / filter  s sort  v variant  l limits  ? help  q quit"
         }
         Screen::Trial => {
-            "r run  v variant  c compare  +- zoom  <- -> pan  , . cursor  x o a f views  ? help"
+            "r run  v variant  c compare  +- zoom  <- -> pan  , . cursor  x o a f D views  ? help"
         }
         Screen::Compare => "<- -> variant  Space choose  w save  r run  Esc back  ? help",
         Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
-        Screen::Views => "x scatter  o globe  a applied  f stick  t time colour  Esc back  ? help",
+        Screen::Views => {
+            "x scatter  o globe  a applied  f stick  D heading  t time  Esc back  ? help"
+        }
         Screen::Calibration => "Up/Down recording  r read again  Esc back  ? help  q quit",
         Screen::Histogram => {
             "Enter suggest  w centroids  <- -> span  +- length  Home 30 s  End all  Esc back"

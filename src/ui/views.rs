@@ -1,7 +1,8 @@
 //! The analysis views of the open trial (issue 7): 3-D scatter projections
 //! ([`super::scatter`], key `x`), the globographic plot ([`super::globe`], `o`),
 //! the applied correction over time ([`super::applied`], `a`) and the stick
-//! figure ([`super::stick`], `f`). This module holds their state, their keys
+//! figure ([`super::stick`], `f`), and the heading drift per IMU
+//! ([`super::heading`], `D`). This module holds their state, their keys
 //! and what they share; the numbers come from [`crate::analysis`].
 
 use super::app::{App, JointAngles, Screen, TrialEntry};
@@ -24,6 +25,8 @@ pub enum ViewKind {
     Globe,
     Applied,
     Stick,
+    /// The heading drift per IMU of a heading variant ([`super::heading`]).
+    Heading,
 }
 
 impl ViewKind {
@@ -34,6 +37,7 @@ impl ViewKind {
             ViewKind::Globe => "globe",
             ViewKind::Applied => "applied",
             ViewKind::Stick => "stick",
+            ViewKind::Heading => "heading",
         }
     }
 
@@ -44,6 +48,7 @@ impl ViewKind {
             ViewKind::Globe,
             ViewKind::Applied,
             ViewKind::Stick,
+            ViewKind::Heading,
         ]
         .into_iter()
         .find(|k| k.name() == name)
@@ -102,6 +107,7 @@ pub fn action(app: &mut App, a: Action) {
         Action::Globe => open(app, ViewKind::Globe),
         Action::Applied => open(app, ViewKind::Applied),
         Action::Stick => open(app, ViewKind::Stick),
+        Action::HeadingDrift => open(app, ViewKind::Heading),
         Action::TimeColour => v.time_colour = !v.time_colour,
         Action::Up => app.joint = app.joint.saturating_sub(1),
         Action::Down => app.joint = (app.joint + 1).min(joints.saturating_sub(1)),
@@ -157,6 +163,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         ViewKind::Globe => super::globe::render(app, e, theme, f, area),
         ViewKind::Applied => super::applied::render(app, e, theme, f, area),
         ViewKind::Stick => super::stick::render(app, e, theme, f, area),
+        ViewKind::Heading => super::heading::render(app, e, theme, f, area),
     }
 }
 
