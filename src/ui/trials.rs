@@ -31,6 +31,16 @@ fn short_name(v: Variant) -> &'static str {
     }
 }
 
+/// The name column's header: the filter first while there is one, so it
+/// stays in view however narrow the column.
+fn name_header(filter: &str, sort: &str) -> String {
+    if filter.is_empty() {
+        format!("trial (sort: {sort})")
+    } else {
+        format!("{}  (sort: {sort})", filter.trim_start())
+    }
+}
+
 pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let details_h = if area.height >= 16 { 5 } else { 0 };
     let [list, details] =
@@ -57,7 +67,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let mut lines = vec![Line::from(Span::styled(
         format!(
             "  {}{:>8}{:>6}{:>5}{}{:>7}{:>7}",
-            fit(&format!("trial (sort: {}){filter}", app.sort.name()), nw),
+            fit(&name_header(&filter, app.sort.name()), nw),
             "dur s",
             "Hz",
             "IMUs",
