@@ -238,7 +238,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
     };
     let (truth_csv, truth_json) = save(&trial, &sim.truth, out, common.truth_json_only)?;
 
-    println!(
+    outln!(
         "wrote {}: {} IMUs, {} samples ({} s at {} Hz), seed {}, noise {} deg",
         out.display(),
         trial.imus.len(),
@@ -247,7 +247,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
         cfg.rate_hz,
         cfg.seed,
         cfg.noise_deg
-    );
+    )?;
     let misaligned: Vec<String> = sim
         .truth
         .meta
@@ -260,21 +260,23 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
         })
         .collect();
     if misaligned.is_empty() {
-        println!("  misalignment: none");
+        outln!("  misalignment: none")?;
     } else {
-        println!("  misalignment (deg): {}", misaligned.join(", "));
+        outln!("  misalignment (deg): {}", misaligned.join(", "))?;
     }
     for d in &cfg.drifts {
-        println!(
+        outln!(
             "  heading drift: {} from {} s at {} deg/s",
-            d.imu, d.start_s, d.rate_deg_s
-        );
+            d.imu,
+            d.start_s,
+            d.rate_deg_s
+        )?;
     }
-    println!("wrote {} (segment orientations)", truth_csv.display());
-    println!(
+    outln!("wrote {} (segment orientations)", truth_csv.display())?;
+    outln!(
         "wrote {} (configuration, misalignments, drifts)",
         truth_json.display()
-    );
+    )?;
     Ok(0)
 }
 
