@@ -140,3 +140,27 @@ fn malformed_input_names_file_line_and_column() {
         "{err}"
     );
 }
+
+#[test]
+fn output_into_a_closed_pipe_is_not_a_panic() {
+    // `acmw report T --json | head -1`: the reader goes away before acmw writes.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_acmw"))
+        .current_dir(root)
+        .args([
+            "report",
+            "sample_trials/knee_calf_z15.csv.gz",
+            "--variant",
+            "basic",
+            "--json",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(out.status.code(), Some(0), "{err}");
+}

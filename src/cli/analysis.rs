@@ -155,21 +155,21 @@ pub fn run_suggest(a: SuggestArgs) -> anyhow::Result<i32> {
     let pooled = pooled(&ctx, &trials, span, false)?;
     let hists = histograms(&pooled, &ctx.limits, &ctx.model, DEFAULT_BIN_DEG);
     let s = suggest_limits(&ctx.limits, &hists, span, SuggestOptions::default());
-    println!(
+    outln!(
         "Suggested limits from {} trial(s), {} (90% of the samples around the mean); against {}:",
         trials.len(),
         span.label(),
         ctx.limits_source
-    );
+    )?;
     for line in s.diff_lines() {
-        println!("{line}");
+        outln!("{line}")?;
     }
     if a.dry_run {
         return Ok(super::EXIT_OK);
     }
     let original = original_table(&a.table)?;
     write_table(&s.table, &a.out, Some(&original))?;
-    println!("wrote {}", a.out.display());
+    outln!("wrote {}", a.out.display())?;
     Ok(super::EXIT_OK)
 }
 
@@ -180,7 +180,7 @@ pub fn run_centroids(a: CentroidArgs) -> anyhow::Result<i32> {
     let pooled = pooled(&ctx, &trials, span, a.by_joint)?;
     let table = centroids(&pooled, span);
     let csv = table.to_csv();
-    print!("{csv}");
+    out!("{csv}")?;
     if let Some(out) = &a.out {
         write_csv(out, &csv)?;
         eprintln!("wrote {}", out.display());

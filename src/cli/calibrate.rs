@@ -45,10 +45,10 @@ pub fn run(args: CalibrateArgs) -> anyhow::Result<i32> {
         .unwrap_or_else(|| default_output(&args.recording));
     cal.save(&output)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&cal)?);
+        outln!("{}", serde_json::to_string_pretty(&cal)?)?;
     } else if !args.quiet {
-        print!("{}", format_text(&cal, truth.as_ref()));
-        println!("wrote {}", output.display());
+        out!("{}", format_text(&cal, truth.as_ref()))?;
+        outln!("wrote {}", output.display())?;
     }
     Ok(0)
 }
@@ -320,13 +320,13 @@ pub fn simulate_run(a: SimulateCalibrationArgs) -> anyhow::Result<i32> {
         serde_json::to_string_pretty(&sim.config)?.as_bytes(),
     )
     .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", truth.display()))?;
-    println!(
+    outln!(
         "{}: {} samples, {} IMUs, protocol {} (truth {})",
         a.output.display(),
         sim.recording.len(),
         sim.recording.imus.len(),
         protocol.name,
         truth.display()
-    );
+    )?;
     Ok(0)
 }

@@ -135,15 +135,18 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             eprintln!("skipped {}: {}", s.joint, s.reason);
         }
         if let Some(p) = &pose {
-            println!(
+            outln!(
                 "{}: pose calibration at {} s ({} samples), heading correction {:.2} deg",
-                trial.name, p.calibration.at, p.samples, p.heading_deg
-            );
+                trial.name,
+                p.calibration.at,
+                p.samples,
+                p.heading_deg
+            )?;
         }
         match &correction.ik {
             Some(run) => {
                 let s = run.summary();
-                println!(
+                outln!(
                     "{}: ik, {} coordinates, RMS orientation error {:.3} deg (max {:.3}), {:.1} steps per frame -> {} and {} (sidecar {})",
                     trial.name,
                     s.coordinates.len(),
@@ -153,15 +156,15 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
                     output.display(),
                     coordinates_path(&output).display(),
                     sc_path.display()
-                );
+                )?;
             }
-            None => println!(
+            None => outln!(
                 "{}: {variant}, {} joints corrected -> {} (sidecar {})",
                 trial.name,
                 correction.joints.len(),
                 output.display(),
                 sc_path.display()
-            ),
+            )?,
         }
     }
     Ok(0)

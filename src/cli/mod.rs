@@ -8,6 +8,23 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
+/// `println!` to standard output that returns an `io::Result` instead of
+/// panicking when the reader has gone (`acmw report T | head`).
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*)
+    }};
+}
+
+/// `print!` to standard output, as [`outln!`].
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*)
+    }};
+}
+
 mod analysis;
 mod calibrate;
 mod common;
@@ -79,6 +96,8 @@ pub fn run(cli: Cli) -> i32 {
     };
     match result {
         Ok(code) => code,
+        // The reader of our output closed it (`| head`): stop quietly.
+        Err(e) if is_broken_pipe(&e) => EXIT_OK,
         Err(e) => {
             eprintln!("acmw: {e:#}");
             if is_bad_input(&e) {
@@ -88,6 +107,14 @@ pub fn run(cli: Cli) -> i32 {
             }
         }
     }
+}
+
+/// The error is standard output's reader having gone away.
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }
 
 /// Bare `acmw`: the terminal workbench, when there is a terminal.

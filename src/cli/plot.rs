@@ -64,7 +64,7 @@ pub fn run(a: PlotArgs) -> anyhow::Result<i32> {
         PlotKind::Scatter => super::plot_views::scatter(&a, &ctx, &trials[0], size)?,
         PlotKind::Globe => super::plot_views::globe(&a, &ctx, &trials[0], size)?,
     }
-    println!("wrote {}", a.output.display());
+    outln!("wrote {}", a.output.display())?;
     Ok(super::EXIT_OK)
 }
 

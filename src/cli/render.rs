@@ -67,6 +67,6 @@ pub fn run(a: RenderArgs, theme: &str) -> anyhow::Result<i32> {
     } else {
         buffer_text(&buf)
     };
-    print!("{text}");
+    out!("{text}")?;
     Ok(super::EXIT_OK)
 }

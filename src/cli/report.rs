@@ -95,9 +95,9 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     }
     progress.finish();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&r)?);
+        outln!("{}", serde_json::to_string_pretty(&r)?)?;
     } else {
-        print!("{}", format_text(&r));
+        out!("{}", format_text(&r))?;
     }
     Ok(0)
 }

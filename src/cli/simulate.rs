@@ -265,7 +265,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
     };
     let (truth_csv, truth_json) = save(&trial, &sim.truth, out, common.truth_json_only)?;
 
-    println!(
+    outln!(
         "wrote {}: {} IMUs, {} samples ({} s at {} Hz), seed {}, noise {} deg",
         out.display(),
         trial.imus.len(),
@@ -274,7 +274,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
         cfg.rate_hz,
         cfg.seed,
         cfg.noise_deg
-    );
+    )?;
     let misaligned: Vec<String> = sim
         .truth
         .meta
@@ -287,27 +287,32 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
         })
         .collect();
     if misaligned.is_empty() {
-        println!("  misalignment: none");
+        outln!("  misalignment: none")?;
     } else {
-        println!("  misalignment (deg): {}", misaligned.join(", "));
+        outln!("  misalignment (deg): {}", misaligned.join(", "))?;
     }
     for d in &cfg.drifts {
-        println!(
+        outln!(
             "  heading drift: {} from {} s at {} deg/s",
-            d.imu, d.start_s, d.rate_deg_s
-        );
+            d.imu,
+            d.start_s,
+            d.rate_deg_s
+        )?;
     }
     for d in &cfg.slips {
-        println!(
+        outln!(
             "  sensor slippage: {} from {} s at {} deg/s about sensor axis {:?}",
-            d.imu, d.start_s, d.rate_deg_s, d.axis
-        );
+            d.imu,
+            d.start_s,
+            d.rate_deg_s,
+            d.axis
+        )?;
     }
-    println!("wrote {} (segment orientations)", truth_csv.display());
-    println!(
+    outln!("wrote {} (segment orientations)", truth_csv.display())?;
+    outln!(
         "wrote {} (configuration, misalignments, drifts)",
         truth_json.display()
-    );
+    )?;
     Ok(0)
 }
 
