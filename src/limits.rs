@@ -129,6 +129,14 @@ pub struct SettingsFile {
     /// `z-up` (default) or `z-down` (north-east-down recordings).
     #[serde(default)]
     pub vertical: Vertical,
+    /// An orientation jump between neighbouring samples larger than this,
+    /// degrees, is flagged as a glitch (reported and shown, never smoothed).
+    #[serde(default = "default_glitch_deg")]
+    pub glitch_deg: f64,
+}
+
+fn default_glitch_deg() -> f64 {
+    crate::trial::glitch::DEFAULT_GLITCH_DEG
 }
 
 impl SettingsFile {
@@ -147,6 +155,17 @@ impl SettingsFile {
             }
         })?;
         s.settings().validate(origin)?;
+        if !(s.glitch_deg.is_finite() && s.glitch_deg > 0.0 && s.glitch_deg <= 180.0) {
+            return Err(LimitsError {
+                file: origin.into(),
+                line: 0,
+                column: 0,
+                message: format!(
+                    "glitch_deg must be a number of degrees in (0, 180], found {}",
+                    s.glitch_deg
+                ),
+            });
+        }
         Ok(s)
     }
 
@@ -163,8 +182,8 @@ impl SettingsFile {
     /// TOML text for saving.
     pub fn to_toml(&self) -> String {
         format!(
-            "# Correction settings (METHOD.md sections 3-4); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n",
-            self.table, self.lambda1, self.window_s, self.hop_s, self.vertical.name()
+            "# Correction settings (METHOD.md sections 3-4); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n",
+            self.table, self.lambda1, self.window_s, self.hop_s, self.vertical.name(), self.glitch_deg
         )
     }
 }
@@ -659,6 +678,20 @@ mod tests {
     }
 
     #[test]
+    fn glitch_threshold_is_a_setting_in_degrees() {
+        let base = "table = \"t.csv\"\nlambda1 = 0.05\nwindow_s = 60.0\nhop_s = 30.0\n";
+        let s = SettingsFile::parse(&format!("{base}glitch_deg = 12.5\n"), "s.toml").unwrap();
+        assert_eq!(s.glitch_deg, 12.5);
+        let again = SettingsFile::parse(&s.to_toml(), "again.toml").unwrap();
+        assert_eq!(again, s);
+        for bad in ["0", "-3", "200", "nan"] {
+            let e =
+                SettingsFile::parse(&format!("{base}glitch_deg = {bad}\n"), "s.toml").unwrap_err();
+            assert!(e.message.contains("glitch_deg"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
     fn limits_dir_falls_back_to_built_ins_and_reads_files() {
         let dir = tempfile::tempdir().unwrap();
         let d = LimitsDir::load(dir.path()).unwrap();
@@ -674,6 +707,8 @@ mod tests {
         std::fs::write(dir.path().join("mine.csv"), mine.to_csv()).unwrap();
         let d = LimitsDir::load(dir.path()).unwrap();
         assert_eq!((d.settings.lambda1, d.table.rows[0].upper_deg), (0.1, 31.0));
+        // glitch_deg defaults to 30 deg when absent.
+        assert_eq!(d.settings.glitch_deg, 30.0);
         assert!(d.table_source.ends_with("mine.csv"));
         std::fs::write(dir.path().join("mine.csv"), "joint,axis\n").unwrap();
         let e = LimitsDir::load(dir.path()).unwrap_err();

@@ -99,6 +99,8 @@ pub struct Context {
     /// Where the table came from (a path or `<built-in NAME>`).
     pub limits_source: String,
     pub settings: Settings,
+    /// Glitch threshold from `settings.toml`, degrees.
+    pub glitch_deg: f64,
 }
 
 /// The folder of limit tables the program uses when none is named: `./joint_limits`.
@@ -138,6 +140,7 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
         limits,
         limits_source,
         settings,
+        glitch_deg: dir.settings.glitch_deg,
     })
 }
 

@@ -60,6 +60,8 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
                 limits,
                 limits_source: s.limits.source.clone(),
                 settings: s.settings,
+                // correct reports no glitches
+                glitch_deg: acm_workbench::trial::glitch::DEFAULT_GLITCH_DEG,
             };
             let pose = s.pose_calibration.as_ref().map(|p| p.calibration);
             (ctx, s.variant, pose)

@@ -16,7 +16,7 @@ pub struct ReportArgs {
     #[arg(long, value_enum)]
     pub variant: Vec<Variant>,
     /// Flag orientation jumps larger than this between neighbouring samples,
-    /// degrees [default: 30].
+    /// degrees [default: `glitch_deg` in ./joint_limits/settings.toml, else 30].
     #[arg(long, value_parser = positive_deg)]
     pub glitch_deg: Option<f64>,
     /// Print JSON instead of text tables.
@@ -90,8 +90,9 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     };
     let mut r = input.run(&variants, &control)?;
     r.pose_calibration = pose;
-    if let Some(deg) = args.glitch_deg {
-        r.set_glitch_threshold(&trial, deg);
+    let glitch_deg = args.glitch_deg.unwrap_or(ctx.glitch_deg);
+    if glitch_deg != r.glitch_deg {
+        r.set_glitch_threshold(&trial, glitch_deg);
     }
     progress.finish();
     if args.json {

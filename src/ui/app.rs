@@ -433,6 +433,8 @@ pub enum Effect {
     Load {
         files: Vec<(String, PathBuf)>,
         limits: LimitTable,
+        /// Glitch threshold, degrees (`settings.toml`).
+        glitch_deg: f64,
     },
     /// Correct a trial with every variant (replacing any job of the same trial),
     /// or re-correct `joints` of the previous results.
@@ -571,6 +573,7 @@ impl App {
                 .map(|t| (t.file.clone(), t.path.clone()))
                 .collect(),
             limits: self.limits.table.clone(),
+            glitch_deg: self.limits.settings.glitch_deg,
         }]
     }
 
@@ -730,6 +733,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             vec![Effect::Load {
                 files: vec![(file, path)],
                 limits: app.limits.table.clone(),
+                glitch_deg: app.limits.settings.glitch_deg,
             }]
         }
         Msg::FileRemoved(file) => {

@@ -8,7 +8,7 @@ use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
 use crate::report::ReportInput;
 use crate::sidecar::{default_output, SaveRequest};
-use crate::trial::glitch::{glitches, DEFAULT_GLITCH_DEG};
+use crate::trial::glitch::glitches;
 use crate::trial::xsens_trial::{is_mapping_file, resolve};
 use crate::trial::{detect_format, detect_model, is_trial_path, read_trial, TrialError};
 use crate::truth::load_truth_beside;
@@ -73,7 +73,8 @@ pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<(LimitTable, 
 }
 
 /// Reads one trial: the trial, its model, its truth and its uncorrected figures.
-pub fn load_trial(file: &str, path: &Path, limits: &LimitTable) -> Msg {
+/// Orientation jumps over `glitch_deg` (degrees) are flagged.
+pub fn load_trial(file: &str, path: &Path, limits: &LimitTable, glitch_deg: f64) -> Msg {
     let shown = |e: TrialError| {
         TrialError {
             file: file.to_string(),
@@ -95,7 +96,7 @@ pub fn load_trial(file: &str, path: &Path, limits: &LimitTable) -> Msg {
             Some(Err(e)) => (None, Some(shown(e))),
         };
         let before = trial_figures(&trial, None, truth.as_ref(), &model, limits);
-        let glitches = glitches(&trial, DEFAULT_GLITCH_DEG);
+        let glitches = glitches(&trial, glitch_deg);
         Ok(Arc::new(Loaded {
             glitches,
             trial,
@@ -230,9 +231,13 @@ pub fn save_limits(dir: &Path, table_name: &str, table_csv: &str, settings_toml:
 /// Carries out one effect in line; the messages it produces.
 pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
     match effect {
-        Effect::Load { files, limits } => files
+        Effect::Load {
+            files,
+            limits,
+            glitch_deg,
+        } => files
             .iter()
-            .map(|(f, p)| load_trial(f, p, &limits))
+            .map(|(f, p)| load_trial(f, p, &limits, glitch_deg))
             .collect(),
         Effect::Run(job) => {
             let cancel = AtomicBool::new(false);

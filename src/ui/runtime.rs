@@ -214,11 +214,15 @@ impl Workers {
     fn execute(&mut self, effect: Effect) {
         let tx = self.tx.clone();
         match effect {
-            Effect::Load { files, limits } => {
+            Effect::Load {
+                files,
+                limits,
+                glitch_deg,
+            } => {
                 std::thread::spawn(move || {
                     use rayon::prelude::*;
                     files.par_iter().for_each(|(f, p)| {
-                        let _ = tx.send(Event::Msg(jobs::load_trial(f, p, &limits)));
+                        let _ = tx.send(Event::Msg(jobs::load_trial(f, p, &limits, glitch_deg)));
                     });
                 });
             }
