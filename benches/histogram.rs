@@ -8,8 +8,9 @@
 use acm_workbench::analysis::TimeSpan;
 use acm_workbench::simulate::{simulate, SimConfig};
 use acm_workbench::trial::{write_trial, TrialFormat};
+use acm_workbench::ui::app::Msg;
 use acm_workbench::ui::headless::{load_app, show, Show};
-use acm_workbench::ui::histogram::compute;
+use acm_workbench::ui::histogram::compute_job;
 use acm_workbench::ui::render::render;
 use acm_workbench::ui::theme::Theme;
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -33,19 +34,24 @@ fn benches(c: &mut Criterion) {
         variant: None,
     };
     show(&mut app, &s).unwrap();
-    let files = vec!["long.csv".to_string()];
+    let trials = vec![app.entry("long.csv").unwrap().loaded().unwrap().clone()];
+    let table = app.limits.table.clone();
+    let compute = |span| match compute_job(&trials, span, &table) {
+        Msg::Histograms(_, h) => h,
+        _ => unreachable!(),
+    };
     let mut term = Terminal::new(TestBackend::new(200, 60)).unwrap();
     c.bench_function(
         "draw histogram screen, 30 min trial, first 30 s, 200x60",
         |b| b.iter(|| term.draw(|f| render(&app, &theme, f)).map(|_| ()).unwrap()),
     );
     c.bench_function("histograms of a 30 min trial, first 30 s", |b| {
-        b.iter(|| compute(&app, &files, TimeSpan::FIRST_30_S))
+        b.iter(|| compute(TimeSpan::FIRST_30_S))
     });
     c.bench_function("histograms of a 30 min trial, whole trial", |b| {
-        b.iter(|| compute(&app, &files, TimeSpan::WHOLE))
+        b.iter(|| compute(TimeSpan::WHOLE))
     });
-    let whole = compute(&app, &files, TimeSpan::WHOLE);
+    let whole = compute(TimeSpan::WHOLE);
     if let Some(st) = app.histogram.as_mut() {
         st.span = TimeSpan::WHOLE;
         st.hists = whole;

@@ -457,6 +457,13 @@ pub enum Effect {
     },
     /// Read and calibrate the calibration recordings of this folder.
     Calibrations { dir: PathBuf },
+    /// Histograms of these loaded trials over `span` against `table`
+    /// (answered by `Msg::Histograms`).
+    Histograms {
+        trials: Vec<Arc<Loaded>>,
+        span: crate::analysis::TimeSpan,
+        table: LimitTable,
+    },
     /// Write a table (CSV text) atomically, never over `original`.
     WriteTable {
         path: PathBuf,
@@ -522,6 +529,11 @@ pub enum Msg {
     Tick,
     /// The calibration recordings of the folder, read and calibrated (protocol label).
     Calibrations(Vec<super::calibration::CalibEntry>, String),
+    /// The histograms of the histogram screen's trials over a span.
+    Histograms(
+        crate::analysis::TimeSpan,
+        Vec<crate::analysis::histogram::JointHistogram>,
+    ),
     /// A suggested limit table or a centroid table was written (its path), or why not.
     TableWritten(Result<String, String>),
     /// A pose-calibrated version of a trial, or why there is none.
@@ -860,6 +872,10 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
         }
         Msg::Calibrations(entries, protocol) => {
             super::calibration::loaded(app, entries, protocol);
+            vec![]
+        }
+        Msg::Histograms(span, hists) => {
+            super::histogram::received(app, span, hists);
             vec![]
         }
         Msg::TableWritten(result) => {

@@ -122,7 +122,8 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
         "histogram" => {
             let t = trial.ok_or("no trial could be read")?;
             open(app, t.clone());
-            super::histogram::open(app);
+            let fx = super::histogram::open(app);
+            SyncRunner::run(app, fx);
             if let (Some(j), Some(st)) = (&s.joint, app.histogram.as_mut()) {
                 st.joint = st
                     .hists

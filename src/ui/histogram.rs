@@ -8,7 +8,7 @@
 //! The trials are the open one (from the trial screen) or every loaded trial
 //! the trials screen shows (filter with `/` first to choose).
 
-use super::app::{App, Effect, Msg, Screen};
+use super::app::{App, Effect, Loaded, Msg, Screen};
 use super::keymap::Action;
 use super::render::{centred, fit, sel};
 use super::theme::Theme;
@@ -17,7 +17,6 @@ use crate::analysis::histogram::{histograms, AxisHistogram, JointHistogram, DEFA
 use crate::analysis::suggest::{same_file, suggest_limits, SuggestOptions, Suggestion, WriteError};
 use crate::analysis::{pool_by_joint, pool_by_table_row, TimeSpan, TrialRef};
 use crate::limits::axis_name;
-#[cfg(test)]
 use crate::limits::LimitTable;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::symbols::Marker;
@@ -38,8 +37,11 @@ pub struct HistogramState {
     /// Trial files the histograms pool.
     pub files: Vec<String>,
     pub span: TimeSpan,
-    /// One per joint, in model order.
+    /// One per joint, in model order, of the span last computed.
     pub hists: Vec<JointHistogram>,
+    /// Still computing `span` in the background: `hists` are of an earlier
+    /// span (or empty) until it arrives.
+    pub computing: bool,
     /// Selected joint (index into `hists`).
     pub joint: usize,
     /// A suggested table waiting for y (save) or n (cancel), and the diff's scroll.
@@ -62,18 +64,57 @@ pub fn open(app: &mut App) -> Vec<Effect> {
         app.message = Some(("no loaded trial to take histograms of".into(), true));
         return vec![];
     }
-    let hists = compute(app, &files, TimeSpan::FIRST_30_S);
+    let effect = request(app, &files, TimeSpan::FIRST_30_S);
     app.histogram = Some(HistogramState {
         from: app.screen,
         files,
         span: TimeSpan::FIRST_30_S,
-        hists,
+        hists: vec![],
+        computing: true,
         joint: 0,
         suggestion: None,
         scroll: 0,
     });
     app.screen = Screen::Histogram;
-    vec![]
+    vec![effect]
+}
+
+/// The background job computing the histograms of `files` over `span`.
+fn request(app: &App, files: &[String], span: TimeSpan) -> Effect {
+    Effect::Histograms {
+        trials: files
+            .iter()
+            .filter_map(|f| app.entry(f)?.loaded().cloned())
+            .collect(),
+        span,
+        table: app.limits.table.clone(),
+    }
+}
+
+/// Per-joint histograms of loaded trials over `span` (in a worker thread).
+pub fn compute_job(trials: &[Arc<Loaded>], span: TimeSpan, table: &LimitTable) -> Msg {
+    let refs: Vec<TrialRef> = trials
+        .iter()
+        .map(|l| TrialRef {
+            trial: &l.trial,
+            model: &l.model,
+        })
+        .collect();
+    let hists = match refs.first() {
+        None => vec![],
+        Some(r) => histograms(&pool_by_joint(&refs, span), table, r.model, DEFAULT_BIN_DEG),
+    };
+    Msg::Histograms(span, hists)
+}
+
+/// Takes the histograms of the span the screen last asked for; drops those of
+/// spans it has moved past.
+pub fn received(app: &mut App, span: TimeSpan, hists: Vec<JointHistogram>) {
+    if let Some(st) = app.histogram.as_mut().filter(|st| st.span == span) {
+        st.hists = hists;
+        st.computing = false;
+        st.joint = st.joint.min(st.hists.len().saturating_sub(1));
+    }
 }
 
 /// The trials of `files` that are loaded, with their models.
@@ -86,16 +127,6 @@ fn refs<'a>(app: &'a App, files: &[String]) -> Vec<TrialRef<'a>> {
             model: &l.model,
         })
         .collect()
-}
-
-/// Per-joint histograms of `files` over `span`, with the edited limits.
-pub fn compute(app: &App, files: &[String], span: TimeSpan) -> Vec<JointHistogram> {
-    let refs = refs(app, files);
-    let Some(model) = refs.first().map(|r| r.model) else {
-        return vec![];
-    };
-    let pooled = pool_by_joint(&refs, span);
-    histograms(&pooled, &app.limits.table, model, DEFAULT_BIN_DEG)
 }
 
 /// The suggested table's file: `<table stem>.suggested.csv` beside the table.
@@ -151,13 +182,10 @@ pub fn action(app: &mut App, a: Action) -> Vec<Effect> {
         _ => {}
     }
     if span != st.span {
+        st.span = span;
+        st.computing = true;
         let files = st.files.clone();
-        let hists = compute(app, &files, span);
-        if let Some(st) = app.histogram.as_mut() {
-            st.span = span;
-            st.hists = hists;
-            st.joint = st.joint.min(st.hists.len().saturating_sub(1));
-        }
+        return vec![request(app, &files, span)];
     }
     vec![]
 }
@@ -273,6 +301,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             Span::styled("mean", theme.centroid),
             Span::raw(" "),
             Span::styled("90%", theme.corrected),
+            Span::styled(if st.computing { "  computing..." } else { "" }, theme.warn),
         ])),
         head,
     );
@@ -284,6 +313,8 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                 axis_chart(f, parts[axis], theme, axis, a, range);
             }
         }
+    } else if st.computing {
+        f.render_widget(Paragraph::new(" computing the histograms..."), charts);
     } else {
         f.render_widget(Paragraph::new(" no samples in this span"), charts);
     }
@@ -517,11 +548,29 @@ mod tests {
         // From the trials screen: every loaded trial the list shows.
         key(&mut app, KeyCode::Esc);
         let fx = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('H'))));
-        assert!(fx.is_empty());
-        assert_eq!(
-            app.histogram.as_ref().unwrap().files,
-            ["fb.csv.gz", "knee.csv"]
-        );
+        // The histograms come from a background job; the screen says so meanwhile.
+        assert!(matches!(fx[..], [Effect::Histograms { .. }]), "{fx:?}");
+        let st = app.histogram.as_ref().unwrap();
+        assert_eq!(st.files, ["fb.csv.gz", "knee.csv"]);
+        assert!(st.computing && st.hists.is_empty());
+        let text = buffer_text(&draw(&app, &Theme::default(), 120, 40));
+        assert!(text.contains("computing the histograms"), "{text}");
+        // A late answer for a span the screen has left is dropped.
+        let Effect::Histograms { trials, table, .. } = &fx[0] else {
+            unreachable!()
+        };
+        let Msg::Histograms(_, stale) = compute_job(trials, TimeSpan::WHOLE, table) else {
+            unreachable!()
+        };
+        received(&mut app, TimeSpan::WHOLE, stale);
+        assert!(app.histogram.as_ref().unwrap().computing);
+        SyncRunner::run(&mut app, fx);
+        let st = app.histogram.as_ref().unwrap();
+        assert!(!st.computing);
+        // Both trials pooled: the knee trial adds its l_knee samples.
+        assert_eq!(st.hists.len(), 12);
+        let knee = st.hists.iter().find(|h| h.name == "l_knee").unwrap();
+        assert_eq!(knee.trials, 2);
     }
 
     #[test]

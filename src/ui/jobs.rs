@@ -267,6 +267,11 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
         } => vec![save_limits(&dir, &table_name, &table_csv, &settings_toml)],
         Effect::Debounce => vec![Msg::RecorrectDue],
         Effect::Calibrations { dir } => vec![super::calibration::scan(&dir)],
+        Effect::Histograms {
+            trials,
+            span,
+            table,
+        } => vec![super::histogram::compute_job(&trials, span, &table)],
         Effect::WriteTable {
             path,
             original,
