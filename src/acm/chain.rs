@@ -7,6 +7,7 @@
 
 use super::cost::WindowCost;
 use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
+use super::lookahead::{ChildJoint, Lookahead};
 use super::minimise::{minimise, MinimiseOptions, Solution};
 use super::window::{correction_series, layout, whole_trial, Window};
 use super::{
@@ -183,8 +184,23 @@ fn run(
                         lambda1: settings.lambda1,
                         vertical: settings.vertical,
                     };
+                    let children: Vec<ChildJoint> = todo
+                        .iter()
+                        .filter(|(c, _)| model.joints[*c].proximal == joint.distal)
+                        .map(|(c, limits)| ChildJoint {
+                            child: &trial
+                                .imu(&model.joints[*c].distal)
+                                .expect("present")
+                                .orientation,
+                            limits,
+                        })
+                        .collect();
+                    let lookahead = Lookahead {
+                        own: problem,
+                        children: &children,
+                    };
                     let (sol, heading, orientation) =
-                        solve_heading(&trial.time_s, &problem, &joint.name, &joint.distal);
+                        solve_heading(&trial.time_s, &lookahead, &joint.name, &joint.distal);
                     windows.iter().for_each(|_| progress());
                     let applied = Applied::Kept(orientation);
                     return Ok((*k, result(sol, None), applied, Some(heading)));
@@ -270,11 +286,12 @@ enum Applied {
 /// its corrected orientations `R_up(-h(t)) G_R_dist C`.
 fn solve_heading(
     time_s: &[f64],
-    problem: &HeadingProblem,
+    lookahead: &Lookahead,
     joint: &str,
     imu: &str,
 ) -> (Vec<WindowSolution>, ImuHeading, Vec<Quat>) {
-    let fit = problem.fit(&HeadingOptions::default());
+    let fit = lookahead.fit(&HeadingOptions::default());
+    let problem = &lookahead.own;
     let c = canonical(&fit.c);
     let windows: Vec<WindowSolution> = problem
         .windows

@@ -128,7 +128,7 @@ pub struct HeadingProblem<'a> {
 
 impl HeadingProblem<'_> {
     /// The C-step costs: per window `Rm_i = P_i'^T R_up(-h_k) D_i`.
-    fn c_costs(&self, headings: &[f64], stride: usize) -> Vec<WindowCost> {
+    pub(super) fn c_costs(&self, headings: &[f64], stride: usize) -> Vec<WindowCost> {
         self.windows
             .iter()
             .zip(headings)
@@ -145,7 +145,7 @@ impl HeadingProblem<'_> {
             .collect()
     }
 
-    fn heading_cost(&self, w: &Window, c: &Quat, stride: usize) -> HeadingCost {
+    pub(super) fn heading_cost(&self, w: &Window, c: &Quat, stride: usize) -> HeadingCost {
         HeadingCost::new(
             &self.parent[w.first..w.end],
             &self.child[w.first..w.end],
@@ -158,7 +158,7 @@ impl HeadingProblem<'_> {
     }
 
     /// `J(C, h)` on every `stride`-th sample.
-    fn total_at(&self, c: &Quat, headings: &[f64], stride: usize) -> f64 {
+    pub(super) fn total_at(&self, c: &Quat, headings: &[f64], stride: usize) -> f64 {
         let costs: Vec<f64> = self
             .windows
             .par_iter()
@@ -234,6 +234,24 @@ const WARM_STEP_RAD: f64 = 0.02;
 /// Simplex size that ends a C step of the coarse phase, radians (~0.001 deg).
 const COARSE_TOL_RAD: f64 = 2e-5;
 
+/// The Nelder-Mead options of a C step in round `round` (from 1) on every
+/// `stride`-th sample.
+pub(super) fn c_step_options(round: usize, stride: usize) -> MinimiseOptions {
+    let mut nm = MinimiseOptions::default();
+    if round > 1 {
+        // Warm start: C moves little between rounds, and the next round
+        // restarts from here anyway.
+        nm.initial_step_rad = WARM_STEP_RAD;
+        nm.max_restarts = 1;
+    }
+    if stride > 1 {
+        // The coarse phase only brings the solution near the optimum.
+        nm.tol_x_rad = COARSE_TOL_RAD;
+        nm.tol_f = 1e-8;
+    }
+    nm
+}
+
 /// The state of the alternation.
 struct Alternation {
     c: Quat,
@@ -257,19 +275,7 @@ impl Alternation {
             costs.truncate(1);
         }
         let total = |q: &Quat| costs.iter().map(|k| k.eval(q)).sum::<f64>();
-        let mut nm = MinimiseOptions::default();
-        if self.rounds > 1 {
-            // Warm start: C moves little between rounds, and the next round
-            // restarts from here anyway.
-            nm.initial_step_rad = WARM_STEP_RAD;
-            nm.max_restarts = 1;
-        }
-        if stride > 1 {
-            // The coarse phase only brings the solution near the optimum.
-            nm.tol_x_rad = COARSE_TOL_RAD;
-            nm.tol_f = 1e-8;
-        }
-        let s = minimise(&total, &[self.c], &nm);
+        let s = minimise(&total, &[self.c], &c_step_options(self.rounds, stride));
         self.c_evaluations += s.evaluations;
         self.sample_evaluations += s.evaluations * costs.iter().map(WindowCost::len).sum::<usize>();
         self.c = s.c;
@@ -297,7 +303,12 @@ impl Alternation {
 /// circle first, then a pattern search (step halved until 1e-6 deg) from the
 /// cheapest of `starts` and the grid's two best local minima. Never returns a
 /// point costlier than `starts[0]`. Returns the heading and the evaluations spent.
-fn line_search(f: &dyn Fn(f64) -> f64, starts: &[f64], scan: bool, scan_step: f64) -> (f64, usize) {
+pub(super) fn line_search(
+    f: &dyn Fn(f64) -> f64,
+    starts: &[f64],
+    scan: bool,
+    scan_step: f64,
+) -> (f64, usize) {
     let mut evals = 0;
     let mut eval = |x: f64| {
         evals += 1;

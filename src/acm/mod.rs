@@ -10,7 +10,9 @@ pub mod chain;
 pub mod cost;
 pub mod heading;
 pub mod heading_cost;
+pub mod lookahead;
 pub mod minimise;
+pub mod parent_cost;
 pub mod window;
 
 pub use chain::{correct_joint, correct_trial, recorrect};

@@ -1,0 +1,159 @@
+//! The ACM cost of a child joint over one window as a function of its
+//! **proximal** IMU's sensor-frame correction `C_p` (the lookahead of
+//! [`super::lookahead`]).
+//!
+//! With the proximal IMU corrected as `G_R_prox' = R_up(-h) G_R_prox C_p` and the
+//! distal one as `G_R_dist' = R_up(-h_d) G_R_dist C_d`, the joint rotation is
+//! `Rt = C_p^T B` with `B = G_R_prox^T R_up(h - h_d) G_R_dist C_d`, fixed here.
+//! Only the five entries of `Rt` the Z-Y-X angles need are formed, from the rows
+//! of `C_p^T` and the columns of `B`; the centroid term uses
+//! `(c_p^-1 b) . q_c = b . (c_p q_c)`, one 4-vector per evaluation.
+//!
+//! The value is the mean per-sample part of the window cost of METHOD.md
+//! section 3, without any `lambda1` term (the penalties of `C_p` and of the
+//! distal IMU's correction are counted by the caller, once each):
+//! `(1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i)`, degrees.
+
+use super::cost::{ArcRange, PitchRange};
+use crate::limits::JointLimits;
+use crate::rotation::{quat_from_euler_zyx_deg, Quat};
+
+/// One sample: the columns of `B` and its quaternion `[w, x, y, z]`.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    col0: [f64; 3],
+    col1: [f64; 3],
+    col2: [f64; 3],
+    q: [f64; 4],
+}
+
+/// A child joint's window cost as a function of the proximal IMU's correction.
+#[derive(Debug, Clone)]
+pub struct ParentCost {
+    samples: Vec<Sample>,
+    x: ArcRange,
+    y: PitchRange,
+    z: ArcRange,
+    centroid: Option<Quat>,
+    lambda2: f64,
+}
+
+impl ParentCost {
+    /// Prepares the cost for the fixed right factors `B_i` (see the module docs).
+    pub fn new(b: impl Iterator<Item = Quat>, limits: &JointLimits) -> Self {
+        let samples = b
+            .map(|q| {
+                let m = q.to_rotation_matrix();
+                let m = m.matrix();
+                Sample {
+                    col0: [m[(0, 0)], m[(1, 0)], m[(2, 0)]],
+                    col1: [m[(0, 1)], m[(1, 1)], m[(2, 1)]],
+                    col2: [m[(0, 2)], m[(1, 2)], m[(2, 2)]],
+                    q: [q.w, q.i, q.j, q.k],
+                }
+            })
+            .collect();
+        let centroid = match limits.centroid_deg {
+            Some(c) if limits.lambda2 > 0.0 => Some(quat_from_euler_zyx_deg(c)),
+            _ => None,
+        };
+        ParentCost {
+            samples,
+            x: ArcRange::new(limits.range_deg[0]),
+            y: PitchRange::new(limits.range_deg[1]),
+            z: ArcRange::new(limits.range_deg[2]),
+            centroid,
+            lambda2: limits.lambda2,
+        }
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// True when the window holds no sample.
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// Mean excursion (plus centroid term) of `Rt = C_p^T B` over the samples,
+    /// degrees; 0 for an empty window.
+    pub fn eval(&self, c_p: &Quat) -> f64 {
+        if self.samples.is_empty() {
+            return 0.0;
+        }
+        // Rows of C_p^T are the columns of C_p.
+        let m = c_p.to_rotation_matrix();
+        let m = m.matrix();
+        let row0 = [m[(0, 0)], m[(1, 0)], m[(2, 0)]];
+        let row1 = [m[(0, 1)], m[(1, 1)], m[(2, 1)]];
+        let row2 = [m[(0, 2)], m[(1, 2)], m[(2, 2)]];
+        let dot = |r: &[f64; 3], k: &[f64; 3]| r[0] * k[0] + r[1] * k[1] + r[2] * k[2];
+        let mut sum = 0.0;
+        for s in &self.samples {
+            let r00 = dot(&row0, &s.col0);
+            let r10 = dot(&row1, &s.col0);
+            let r20 = dot(&row2, &s.col0);
+            let r21 = dot(&row2, &s.col1);
+            let r22 = dot(&row2, &s.col2);
+            sum += self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00);
+        }
+        if let Some(qc) = self.centroid {
+            let p = c_p * qc;
+            let p = [p.w, p.i, p.j, p.k];
+            let mut centroid_sum = 0.0;
+            for s in &self.samples {
+                let d = s.q[0] * p[0] + s.q[1] * p[1] + s.q[2] * p[2] + s.q[3] * p[3];
+                centroid_sum += (2.0 - 2.0 * d.abs()).max(0.0).sqrt();
+            }
+            sum += self.lambda2 * centroid_sum;
+        }
+        sum / self.samples.len() as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::acm::cost::cost_direct;
+    use crate::rotation::quat_axis_angle_deg;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_quat(rng: &mut ChaCha8Rng, max_deg: f64) -> Quat {
+        let axis = [
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        ];
+        quat_axis_angle_deg(axis, rng.random_range(0.0..max_deg))
+    }
+
+    fn check(limits: JointLimits) {
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        let b: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
+        let cost = ParentCost::new(b.iter().copied(), &limits);
+        for _ in 0..30 {
+            let c = random_quat(&mut rng, 60.0);
+            let turned: Vec<Quat> = b.iter().map(|q| c.inverse() * q).collect();
+            let direct = cost_direct(&turned, &Quat::identity(), &limits, 0.0);
+            let fast = cost.eval(&c);
+            assert!((fast - direct).abs() < 1e-9, "{fast} vs {direct}");
+        }
+    }
+
+    #[test]
+    fn parent_cost_equals_the_direct_formula() {
+        check(JointLimits {
+            range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
+            centroid_deg: None,
+            lambda2: 0.0,
+        });
+        check(JointLimits {
+            range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
+            centroid_deg: Some([47.0, -1.0, -31.0]),
+            lambda2: 30.0,
+        });
+    }
+}
