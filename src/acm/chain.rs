@@ -47,8 +47,10 @@ pub fn correct_trial(
 }
 
 /// Re-corrects the named joints and everything below them, reusing `previous`
-/// for the rest (after a limit edit, say). `previous` must come from the same
-/// trial, model and variant.
+/// for the rest (after a limit edit, say). For the heading variants the joint
+/// above each named one is redone too, with everything below it: its IMU's fit
+/// looks ahead at the named joint's limits ([`super::lookahead`]). `previous`
+/// must come from the same trial, model and variant.
 pub fn recorrect(
     trial: &Trial,
     model: &Model,
@@ -65,8 +67,16 @@ pub fn recorrect(
     let mut redo = BTreeSet::new();
     for (k, j) in model.joints.iter().enumerate() {
         if joints.contains(&j.name.as_str()) {
-            redo.insert(k);
-            redo.extend(model.descendants(k));
+            // The heading variants fit a joint's parent IMU with this joint's
+            // limits too (the lookahead): the parent joint is redone as well.
+            let parent = model
+                .joints
+                .iter()
+                .position(|p| p.distal == j.proximal)
+                .filter(|_| previous.variant.heading())
+                .unwrap_or(k);
+            redo.insert(parent);
+            redo.extend(model.descendants(parent));
         }
     }
     run(
@@ -474,6 +484,16 @@ mod tests {
     }
 
     fn run_with(trial: &Trial, model: &Model, table: &LimitTable, threads: usize) -> Correction {
+        run_variant(trial, model, table, threads, Variant::DriftCentroid)
+    }
+
+    fn run_variant(
+        trial: &Trial,
+        model: &Model,
+        table: &LimitTable,
+        threads: usize,
+        variant: Variant,
+    ) -> Correction {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
@@ -484,7 +504,7 @@ mod tests {
                     model,
                     table,
                     &Settings::default(),
-                    Variant::DriftCentroid,
+                    variant,
                     &RunControl::default(),
                 )
                 .unwrap()
@@ -533,6 +553,62 @@ mod tests {
     }
 
     #[test]
+    fn heading_output_does_not_depend_on_thread_count() {
+        let (trial, model, table) = fixture();
+        let one = run_variant(&trial, &model, &table, 1, Variant::DriftHeading);
+        let three = run_variant(&trial, &model, &table, 3, Variant::DriftHeading);
+        assert!(!one.headings.is_empty());
+        assert!(one == three, "1 vs 3 threads");
+    }
+
+    /// The knee's table rows narrowed to a flexion range of 20-60 deg.
+    fn narrow_l_knee(table: &mut LimitTable) {
+        for axis in [0, 2] {
+            let mut r = table.row("knee", "knee", axis).unwrap().clone();
+            r.joint = "l_knee".into();
+            table.rows.push(r);
+        }
+        table.rows.push(crate::limits::LimitRow {
+            joint: "l_knee".into(),
+            axis: 1,
+            movement: "flexion/extension".into(),
+            lower_deg: 20.0,
+            upper_deg: 60.0,
+            centroid_deg: None,
+            lambda2: 0.0,
+        });
+    }
+
+    #[test]
+    fn recorrect_with_a_heading_variant_redoes_the_parent_joint_too() {
+        let (trial, model, mut table) = fixture();
+        let settings = Settings::default();
+        let full = run_variant(&trial, &model, &table, 2, Variant::DriftHeading);
+        narrow_l_knee(&mut table);
+        let edited = recorrect(
+            &trial,
+            &model,
+            &table,
+            &settings,
+            &full,
+            &["l_knee"],
+            &RunControl::default(),
+        )
+        .unwrap();
+        // The thigh's fit looks ahead at the knee: the hip changes with it.
+        for j in &model.joints {
+            let changed = edited.joint(&j.name) != full.joint(&j.name);
+            let redone = ["l_hip", "l_knee", "l_ankle"].contains(&j.name.as_str());
+            assert!(redone || !changed, "{}", j.name);
+            if j.name == "l_hip" || j.name == "l_knee" {
+                assert!(changed, "{}", j.name);
+            }
+        }
+        let again = run_variant(&trial, &model, &table, 2, Variant::DriftHeading);
+        assert!(edited == again, "recorrect vs full run");
+    }
+
+    #[test]
     fn recorrect_redoes_a_joint_and_its_descendants_only() {
         let (trial, model, mut table) = fixture();
         let settings = Settings::default();
@@ -549,21 +625,7 @@ mod tests {
         .unwrap();
         assert!(same == full, "recorrect without a change");
         // Narrow the knee's flexion range: knee and ankle change, nothing else.
-        let l_knee = crate::limits::LimitRow {
-            joint: "l_knee".into(),
-            axis: 1,
-            movement: "flexion/extension".into(),
-            lower_deg: 20.0,
-            upper_deg: 60.0,
-            centroid_deg: None,
-            lambda2: 0.0,
-        };
-        for axis in [0, 2] {
-            let mut r = table.row("knee", "knee", axis).unwrap().clone();
-            r.joint = "l_knee".into();
-            table.rows.push(r);
-        }
-        table.rows.push(l_knee);
+        narrow_l_knee(&mut table);
         let edited = recorrect(
             &trial,
             &model,
