@@ -8,9 +8,10 @@
 //! centroid term) is compared per joint against the true joint angles.
 //!
 //! Tolerances: the figures (30% median reduction on the joints touching
-//! a drifting IMU, no other joint worse by more than 0.5 deg, drift rate within
-//! 20%). Both variants of a pair see the same data, so noise cancels out of the
-//! comparison.
+//! a drifting IMU, no other joint worse by more than 0.5 deg, each drifting
+//! IMU's own drift rate within 20%), asserted for both pairs on the preset
+//! `full_body_drift` trial and on a second body. Both variants of a pair see
+//! the same data, so noise cancels out of the comparison.
 
 use acm_workbench::acm::{correct_trial, Correction, RunControl, Variant};
 use acm_workbench::limits::{LimitTable, Settings};
@@ -55,7 +56,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// with the heading model).
 type Rows = Vec<(String, bool, f64, f64)>;
 
-fn compare(sim: &Simulated, disturbed: &[&str], pair: [Variant; 2]) -> Rows {
+/// Compares a pair of variants per joint; returns the rows and the second run.
+fn compare(sim: &Simulated, disturbed: &[&str], pair: [Variant; 2]) -> (Rows, Correction) {
     let a = run(sim, pair[0]);
     let b = run(sim, pair[1]);
     let rows: Rows = Model::infant13()
@@ -80,7 +82,7 @@ fn compare(sim: &Simulated, disturbed: &[&str], pair: [Variant; 2]) -> Rows {
             if *touches { "  (disturbed IMU)" } else { "" }
         );
     }
-    rows
+    (rows, b)
 }
 
 /// Median relative reduction over the joints touching a disturbed IMU, and the
@@ -167,7 +169,7 @@ fn within_20_percent(rate: f64, d: &HeadingDrift) -> bool {
 /// Checks the figures on one trial; returns the heading-model run.
 fn check_drift_case(sim: &Simulated, drifts: &[HeadingDrift], pair: [Variant; 2]) -> Correction {
     let imus: Vec<&str> = drifts.iter().map(|d| d.imu.as_str()).collect();
-    let rows = compare(sim, &imus, pair);
+    let (rows, heading_run) = compare(sim, &imus, pair);
     let (reduction, worst) = summary(&rows);
     eprintln!(
         "{} vs {}: median reduction {:.0}% on the joints touching a drifting IMU; other joints at most {:+.2} deg",
@@ -178,7 +180,7 @@ fn check_drift_case(sim: &Simulated, drifts: &[HeadingDrift], pair: [Variant; 2]
     );
     assert!(reduction >= 0.30, "median reduction {reduction}");
     assert!(worst <= 0.5, "another joint worse by {worst} deg");
-    run(sim, pair[1])
+    heading_run
 }
 
 fn check_rates(c: &Correction, drifts: &[HeadingDrift]) {
@@ -197,31 +199,33 @@ fn check_rates(c: &Correction, drifts: &[HeadingDrift]) {
     }
 }
 
-#[test]
-fn heading_model_follows_heading_drift_with_centroid() {
-    let (sim, drifts) = drifting_trial();
-    let c = check_drift_case(
-        &sim,
-        &drifts,
-        [Variant::DriftCentroid, Variant::DriftHeadingCentroid],
-    );
-    let [calf, arm] = &drifts[..] else {
-        panic!("the preset drifts l_calf and r_upper_arm")
-    };
-    check_rates(&c, std::slice::from_ref(calf));
-    // The upper arm's own joint, the shoulder, has wide limits: a heading drift
-    // leaves its angles inside them and only the centroid term notices. The
-    // elbow (narrow limits) sees the drift relative to the forearm, and in
-    // chain order the forearm takes what the shoulder left. So the upper arm's
-    // own estimate falls short, and the drift relative to its child is right.
-    let own = estimated_rate(&c, arm, None);
-    let relative = estimated_rate(&c, arm, Some("r_forearm"));
+/// The preset's upper arm drifts under a shoulder (wide limits) and above an
+/// elbow (narrow ones): its own joint barely sees the drift, the elbow sees it
+/// relative to the forearm. The lookahead (`src/acm/lookahead.rs`) gives it to
+/// the upper arm; prints the rate relative to the forearm too.
+fn check_preset_rates(c: &Correction, drifts: &[HeadingDrift]) {
+    check_rates(c, drifts);
+    let arm = drifts.iter().find(|d| d.imu == "r_upper_arm").unwrap();
+    let relative = estimated_rate(c, arm, Some("r_forearm"));
     eprintln!(
-        "r_upper_arm: estimated drift rate {own:.4} deg/s own, {relative:.4} relative to r_forearm, simulated {:.4}",
+        "r_upper_arm: {relative:.4} deg/s relative to r_forearm, simulated {:.4}",
         arm.rate_deg_s
     );
     assert!(within_20_percent(relative, arm), "{relative}");
-    assert!(own > 0.5 * arm.rate_deg_s && own < arm.rate_deg_s, "{own}");
+}
+
+#[test]
+fn heading_model_follows_heading_drift_with_centroid() {
+    let (sim, drifts) = drifting_trial();
+    let pair = [Variant::DriftCentroid, Variant::DriftHeadingCentroid];
+    check_preset_rates(&check_drift_case(&sim, &drifts, pair), &drifts);
+}
+
+#[test]
+fn heading_model_follows_heading_drift_without_centroid_preset() {
+    let (sim, drifts) = drifting_trial();
+    let pair = [Variant::Drift, Variant::DriftHeading];
+    check_preset_rates(&check_drift_case(&sim, &drifts, pair), &drifts);
 }
 
 #[test]
@@ -236,26 +240,6 @@ fn heading_model_follows_heading_drift_without_centroid() {
     let (sim, drifts) = second_drifting_trial();
     let pair = [Variant::Drift, Variant::DriftHeading];
     check_rates(&check_drift_case(&sim, &drifts, pair), &drifts);
-}
-
-#[test]
-fn without_centroid_misaligned_parents_dominate() {
-    // On the preset body without the centroid term, the parents' misalignments
-    // that the limits cannot see (the left hip's 18 deg, ...) dominate the
-    // error of the joints below a drifting IMU: the heading model still helps,
-    // but by less than the 30%. Figures for the README, and no joint
-    // may get worse by more than 0.5 deg.
-    let (sim, drifts) = drifting_trial();
-    let imus: Vec<&str> = drifts.iter().map(|d| d.imu.as_str()).collect();
-    let rows = compare(&sim, &imus, [Variant::Drift, Variant::DriftHeading]);
-    let (reduction, worst) = summary(&rows);
-    eprintln!(
-        "drift-heading vs drift on full_body_drift: median reduction {:.0}% on the joints touching a drifting IMU; other joints at most {worst:+.2} deg",
-        100.0 * reduction
-    );
-    assert!(reduction > 0.0, "{reduction}");
-    let worst_all = rows.iter().map(|r| r.3 - r.2).fold(f64::MIN, f64::max);
-    assert!(worst_all <= 0.5, "{worst_all}");
 }
 
 #[test]
@@ -285,7 +269,7 @@ fn sensor_slippage_figures() {
         [Variant::Drift, Variant::DriftHeading],
         [Variant::DriftCentroid, Variant::DriftHeadingCentroid],
     ] {
-        let rows = compare(&sim, &imus, pair);
+        let (rows, _) = compare(&sim, &imus, pair);
         let (reduction, worst) = summary(&rows);
         eprintln!(
             "slippage, {} vs {}: median change {:+.0}% on the joints touching a slipping IMU; other joints at most {:+.2} deg",
