@@ -22,6 +22,10 @@
 //! first C), and the early rounds run on every `coarse_stride`-th sample before
 //! the last rounds polish on all of them. `tests` shows the result costs no
 //! more than plain alternation run to convergence, at a fraction of the work.
+//!
+//! This is the fit of an IMU on its own joint. The engine fits every IMU that
+//! has joints below it with [`super::lookahead`] instead, which adds those
+//! joints to the objective and falls back to this fit for a leaf IMU.
 
 use super::cost::WindowCost;
 use super::heading_cost::HeadingCost;

@@ -5,6 +5,8 @@
 //! Corrections are solved per window and slerped between window centres, joint
 //! by joint down the model's chain, each joint measured against its parent's
 //! corrected orientation: `Rm = (G_R_prox')^T G_R_dist`, `G_R_dist' = G_R_dist C`.
+//! The heading-drift variants fit `G_R_dist' = R_up(-h(t)) G_R_dist C` per IMU
+//! instead ([`heading`]), looking ahead at the joints below it ([`lookahead`]).
 
 pub mod chain;
 pub mod cost;
