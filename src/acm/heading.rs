@@ -43,8 +43,11 @@ pub struct HeadingOptions {
     pub coarse_stride: usize,
     /// Most rounds (each one C step and one heading step) of the coarse phase.
     pub coarse_rounds: usize,
-    /// Most rounds of the full-resolution phase that follows.
+    /// Most rounds of the fine phase that follows.
     pub fine_rounds: usize,
+    /// Sample stride of the fine phase (1 = every sample). The reported
+    /// window costs are always over every sample.
+    pub fine_stride: usize,
     /// Scan the whole circle for each heading in the first round.
     pub global_scan: bool,
     /// Grid step of that scan, degrees.
@@ -60,9 +63,10 @@ pub struct HeadingOptions {
 impl Default for HeadingOptions {
     fn default() -> Self {
         HeadingOptions {
-            coarse_stride: 5,
+            coarse_stride: 20,
             coarse_rounds: 16,
             fine_rounds: 1,
+            fine_stride: 2,
             global_scan: true,
             scan_step_deg: 4.0,
             coarse_tol: 1e-5,
@@ -80,6 +84,7 @@ impl HeadingOptions {
             coarse_stride: 1,
             coarse_rounds: 0,
             fine_rounds: 60,
+            fine_stride: 1,
             global_scan: false,
             scan_step_deg: 4.0,
             coarse_tol: 1e-9,
@@ -195,7 +200,7 @@ impl HeadingProblem<'_> {
         };
         let phases = [
             (opts.coarse_stride, opts.coarse_rounds, opts.coarse_tol),
-            (1, opts.fine_rounds, opts.tol),
+            (opts.fine_stride, opts.fine_rounds, opts.tol),
         ];
         for (stride, max_rounds, tol) in phases {
             let mut last = f64::INFINITY;

@@ -115,7 +115,7 @@ impl Lookahead<'_> {
         };
         let phases = [
             (opts.coarse_stride, opts.coarse_rounds, opts.coarse_tol),
-            (1, opts.fine_rounds, opts.tol),
+            (opts.fine_stride, opts.fine_rounds, opts.tol),
         ];
         for (stride, max_rounds, tol) in phases {
             let mut last = f64::INFINITY;
