@@ -488,10 +488,7 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
                 q
             })
             .collect();
-        measured.push(ImuSeries {
-            name: name.clone(),
-            orientation,
-        });
+        measured.push(ImuSeries::new(name.clone(), orientation));
     }
 
     let label = kind_label(&config.kind);
@@ -507,7 +504,7 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
             time_s,
             imus: segments
                 .into_iter()
-                .map(|(name, orientation)| ImuSeries { name, orientation })
+                .map(|(name, orientation)| ImuSeries::new(name, orientation))
                 .collect(),
             warnings: vec![],
         },

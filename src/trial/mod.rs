@@ -1,11 +1,13 @@
 //! Recorded trials: IMU orientations over time, and their file formats.
 //!
 //! A [`Trial`] holds, per IMU, the orientation `G_R_imu` (sensor frame to global
-//! frame G) at each sample time (seconds). Readers and writers for the supported
+//! frame G) at each sample time (seconds), and optionally the IMU's gyroscope
+//! readings (angular rate, rad/s, sensor frame). Readers and writers for the supported
 //! formats live in the submodules; [`read_trial`] and [`write_trial`] pick by
 //! file name.
 
 use crate::rotation::Quat;
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 mod error;
@@ -19,13 +21,46 @@ pub mod xsens_trial;
 pub use error::TrialError;
 pub use io::*;
 
-/// Orientations of one IMU over the trial's samples.
+/// Orientations (and optionally gyroscope readings) of one IMU over the
+/// trial's samples.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImuSeries {
     /// Canonical IMU name (after the model's aliases).
     pub name: String,
     /// `G_R_imu` per sample, unit quaternions.
     pub orientation: Vec<Quat>,
+    /// Gyroscope readings when the trial has them: the IMU's angular rate in
+    /// rad/s, expressed in its own sensor frame (the body rate `w` of
+    /// `d/dt G_R_imu = G_R_imu [w]x`), one per sample, same length as
+    /// `orientation`. `None` when the trial has no gyroscope columns.
+    pub gyro: Option<Vec<Vector3<f64>>>,
+}
+
+impl ImuSeries {
+    /// A series of orientations without gyroscope readings.
+    pub fn new(name: impl Into<String>, orientation: Vec<Quat>) -> ImuSeries {
+        ImuSeries {
+            name: name.into(),
+            orientation,
+            gyro: None,
+        }
+    }
+
+    /// The same series with gyroscope readings (rad/s, sensor frame).
+    pub fn with_gyro(mut self, gyro: Option<Vec<Vector3<f64>>>) -> ImuSeries {
+        self.gyro = gyro;
+        self
+    }
+
+    /// Re-expresses the gyroscope readings in the sensor frame turned by `r`
+    /// (`G_R_imu' = G_R_imu * r`, `r` constant): `w' = r^-1 w`. The
+    /// orientations are left to the caller. Nothing happens without gyros.
+    pub fn turn_gyro(&mut self, r: &Quat) {
+        let inv = r.inverse();
+        if let Some(g) = &mut self.gyro {
+            g.iter_mut().for_each(|w| *w = inv * *w);
+        }
+    }
 }
 
 /// A recorded (or corrected) trial.
@@ -87,6 +122,36 @@ impl Trial {
     /// Mutable access to the series of the IMU with this canonical name.
     pub fn imu_mut(&mut self, name: &str) -> Option<&mut ImuSeries> {
         self.imus.iter_mut().find(|s| s.name == name)
+    }
+
+    /// The samples at `idx` (in that order, indices into this trial), every
+    /// IMU's orientations and gyroscope readings picked alike: a thinned,
+    /// cut or resampled-by-selection trial keeps its gyros aligned.
+    ///
+    /// # Panics
+    /// When an index is out of range (callers pick from `0..len()`).
+    pub fn select(&self, idx: &[usize], name: &str) -> Trial {
+        Trial {
+            name: name.to_string(),
+            time_s: idx.iter().map(|&i| self.time_s[i]).collect(),
+            imus: self
+                .imus
+                .iter()
+                .map(|s| {
+                    ImuSeries::new(
+                        s.name.clone(),
+                        idx.iter().map(|&i| s.orientation[i]).collect(),
+                    )
+                    .with_gyro(s.gyro.as_ref().map(|g| idx.iter().map(|&i| g[i]).collect()))
+                })
+                .collect(),
+            warnings: self.warnings.clone(),
+        }
+    }
+
+    /// True when any IMU carries gyroscope readings.
+    pub fn has_gyros(&self) -> bool {
+        self.imus.iter().any(|s| s.gyro.is_some())
     }
 
     /// Median interval between samples, seconds (0 for fewer than two samples).

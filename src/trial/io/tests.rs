@@ -28,9 +28,8 @@ fn random_trial(names: &[&str], n: usize, seed: u64) -> Trial {
         .collect();
     let imus = names
         .iter()
-        .map(|name| ImuSeries {
-            name: name.to_string(),
-            orientation: (0..n)
+        .map(|name| {
+            let orientation = (0..n)
                 .map(|_| {
                     let q = quat_from_euler_zyx_deg([
                         rng.random_range(-179.9..179.9),
@@ -44,7 +43,8 @@ fn random_trial(names: &[&str], n: usize, seed: u64) -> Trial {
                         q
                     }
                 })
-                .collect(),
+                .collect();
+            ImuSeries::new(*name, orientation)
         })
         .collect();
     Trial {
