@@ -28,6 +28,8 @@ use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Read, Write as _};
 use std::path::Path;
 
+#[cfg(test)]
+mod gyro_tests;
 pub(crate) mod parse;
 #[cfg(test)]
 mod tests;
