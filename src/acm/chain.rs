@@ -6,12 +6,14 @@
 //! is bit-identical for any thread count.
 //!
 //! Gyroscope readings (sensor frame) follow their IMU's correction: a distal IMU
-//! corrected as `G_R_dist C(t)` reads `C(t)^-1 w` in its corrected frame
-//! (heading fits, `Rz(-h(t)) G_R_dist C`, likewise with their constant C). The
-//! correction's own rate (C changes over tens of seconds, h at fractions of a
-//! degree per second) is left out. The Mueller baseline takes its proximal
-//! gyros from the corrected trial, so they are in the frame its joint
-//! rotations are measured from.
+//! corrected by the ACM as `G_R_dist C(t)` reads `C(t)^-1 w` in its corrected
+//! frame (heading fits, `Rz(-h(t)) G_R_dist C`, likewise with their constant
+//! C); the correction's own rate (C changes over tens of seconds, h at
+//! fractions of a degree per second) is left out. A baseline's `C(t)` turns
+//! with the joint: the baseline gives the corrected readings itself (Mueller,
+//! from both IMUs' gyros) or they are dropped (Rivest). The Mueller baseline
+//! takes its proximal gyros from the corrected trial, so they are in the frame
+//! its joint rotations are measured from.
 
 use super::cost::WindowCost;
 use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
@@ -216,29 +218,28 @@ fn run(
                     }),
                     _ => None,
                 };
-                let (sol, baseline) = match baselines::method_for(variant, &joint.kind) {
-                    Some(method) => solve_baseline(
+                if let Some(method) = baselines::method_for(variant, &joint.kind) {
+                    let (sol, baseline, gyro) = solve_baseline(
                         method,
                         (&trial.time_s, &measured, gyros),
                         &windows,
                         control,
                         &progress,
-                    )?,
-                    None => (
-                        solve_windows(
-                            &trial.time_s,
-                            &measured,
-                            &windows,
-                            lim,
-                            settings.lambda1,
-                            control,
-                            &progress,
-                        )?,
-                        None,
-                    ),
-                };
+                    )?;
+                    let applied = Applied::Baseline(sol.series, gyro);
+                    return Ok((*k, result(sol.windows, baseline), applied, None));
+                }
+                let sol = solve_windows(
+                    &trial.time_s,
+                    &measured,
+                    &windows,
+                    lim,
+                    settings.lambda1,
+                    control,
+                    &progress,
+                )?;
                 let applied = Applied::Series(sol.series);
-                Ok((*k, result(sol.windows, baseline), applied, None))
+                Ok((*k, result(sol.windows, None), applied, None))
             })
             .collect::<Result<_, Cancelled>>()?;
         for (k, result, applied, heading) in solved {
@@ -257,6 +258,12 @@ fn run(
                             *w = c.inverse() * *w;
                         }
                     }
+                }
+                Applied::Baseline(series, gyro) => {
+                    for (q, c) in imu.orientation.iter_mut().zip(&series) {
+                        *q = Quat::new_normalize((*q * c).into_inner());
+                    }
+                    imu.gyro = gyro;
                 }
                 Applied::Kept(orientation, gyro) => {
                     imu.orientation = orientation;
@@ -285,11 +292,16 @@ fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &s
     results.keys().any(|&k| model.joints[k].distal == imu)
 }
 
+/// A baseline's corrected distal gyros (`None`: dropped).
+type BaselineGyro = Option<Vec<Vector3<f64>>>;
+
 /// What a joint's run gives its distal IMU.
 enum Applied {
     /// A fresh per-sample correction `C(t)`, to apply as `G_R_dist * C(t)`
     /// (and `C(t)^-1 w` to the gyros).
     Series(Vec<Quat>),
+    /// A baseline's `C(t)`, applied likewise, and the gyros to take instead.
+    Baseline(Vec<Quat>, BaselineGyro),
     /// Corrected orientations and gyroscope readings to take as they are (a
     /// heading fit, or an earlier run's kept result).
     Kept(Vec<Quat>, Option<Vec<Vector3<f64>>>),
@@ -354,7 +366,14 @@ fn solve_baseline(
     windows: &[Window],
     control: &RunControl,
     progress: &(dyn Fn() + Sync),
-) -> Result<(JointSolution, Option<baselines::BaselineRecord>), Cancelled> {
+) -> Result<
+    (
+        JointSolution,
+        Option<baselines::BaselineRecord>,
+        BaselineGyro,
+    ),
+    Cancelled,
+> {
     if control.cancelled() {
         return Err(Cancelled);
     }
@@ -364,7 +383,7 @@ fn solve_baseline(
         windows: b.windows,
         series: b.series,
     };
-    Ok((sol, Some(b.record)))
+    Ok((sol, Some(b.record), b.gyro))
 }
 
 /// Solves one joint: the measured joint rotations `Rm_i` (parent' to child), per sample.

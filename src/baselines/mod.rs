@@ -110,6 +110,11 @@ pub struct BaselineSolution {
     /// `C(t)` per sample (sensor frame of the distal IMU).
     pub series: Vec<Quat>,
     pub record: BaselineRecord,
+    /// The distal IMU's gyroscope readings in its corrected frame (rad/s), when
+    /// the method can tell them: Mueller from both IMUs' gyros. `None`
+    /// otherwise: `C(t)` turns with the joint, so the recorded readings no
+    /// longer describe the corrected orientation and are dropped.
+    pub gyro: Option<Vec<Vector3<f64>>>,
 }
 
 /// Solves one joint with `method` from the measured joint rotations `Rm_i`
@@ -156,6 +161,7 @@ fn solve_rivest(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> Baseli
         windows: windows_out,
         series,
         record: BaselineRecord::Rivest { fits },
+        gyro: None,
     }
 }
 
@@ -177,6 +183,24 @@ fn mueller_rates(
             RateSource::Orientations,
         ),
     }
+}
+
+/// The distal IMU's gyros after Mueller's correction: as recorded when no
+/// axes were found (no correction), from both IMUs' gyros through
+/// [`MuellerFit::corrected_distal_rates`] when they were, `None` without gyros.
+fn mueller_corrected_gyro(
+    fit: Option<&MuellerFit>,
+    measured: &[Quat],
+    gyros: Option<JointGyros>,
+) -> Option<Vec<Vector3<f64>>> {
+    let g = gyros?;
+    if g.proximal.len() != measured.len() || g.distal.len() != measured.len() {
+        return None;
+    }
+    Some(match fit {
+        None => g.distal.to_vec(),
+        Some(f) => f.corrected_distal_rates(measured, g.proximal, g.distal),
+    })
 }
 
 fn solve_mueller(
@@ -205,6 +229,7 @@ fn solve_mueller(
     BaselineSolution {
         windows: windows_out,
         series,
+        gyro: mueller_corrected_gyro(fit.as_ref(), measured, gyros),
         record: BaselineRecord::Mueller { fit, rates: source },
     }
 }
@@ -255,6 +280,31 @@ mod tests {
     use super::*;
     use crate::acm::window::{layout, whole_trial};
     use crate::rotation::quat_axis_angle_deg;
+
+    #[test]
+    fn mueller_records_say_where_the_rates_came_from_and_old_ones_still_load() {
+        let new = BaselineRecord::Mueller {
+            fit: None,
+            rates: RateSource::Gyroscopes,
+        };
+        let json = serde_json::to_string(&new).unwrap();
+        assert_eq!(
+            json,
+            r#"{"method":"mueller","fit":null,"rates":"gyroscopes"}"#
+        );
+        let back: BaselineRecord = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, new);
+        // Written before gyroscope support: no "rates", which were orientations.
+        let old: BaselineRecord =
+            serde_json::from_str(r#"{"method":"mueller","fit":null}"#).unwrap();
+        assert_eq!(
+            old,
+            BaselineRecord::Mueller {
+                fit: None,
+                rates: RateSource::Orientations
+            }
+        );
+    }
 
     #[test]
     fn only_the_methods_joint_kind_gets_the_baseline() {

@@ -235,4 +235,24 @@ mod tests {
         assert!((t.duration_s() - 60.0).abs() < 1e-9);
         assert!((t.rate_hz() - 50.0).abs() < 1e-9);
     }
+
+    #[test]
+    fn turned_gyros_are_the_rates_of_the_turned_orientations() {
+        use crate::rotation::quat_axis_angle_deg;
+        // A constant body rate w: G_R(t) = G_R0 exp(w t); turned by r the
+        // orientation G_R r turns at r^-1 w in the new frame.
+        let w = Vector3::new(0.4, -1.1, 0.7);
+        let g0 = quat_axis_angle_deg([0.2, 0.9, -0.3], 50.0);
+        let at = |t: f64| g0 * Quat::from_scaled_axis(w * t);
+        let mut s = ImuSeries::new("a", vec![at(0.0)]).with_gyro(Some(vec![w]));
+        let r = quat_axis_angle_deg([1.0, 0.5, 0.0], 35.0);
+        s.turn_gyro(&r);
+        let h = 1e-6;
+        let fd = ((at(-h) * r).inverse() * (at(h) * r)).scaled_axis() / (2.0 * h);
+        assert!((s.gyro.as_ref().unwrap()[0] - fd).norm() < 1e-8);
+        assert!((w - fd).norm() > 0.3, "the turn matters");
+        let mut none = ImuSeries::new("b", vec![at(0.0)]);
+        none.turn_gyro(&r);
+        assert!(none.gyro.is_none());
+    }
 }
