@@ -69,13 +69,14 @@ pub enum Command {
     Report(report::ReportArgs),
     /// Simulate a trial with known misalignment and drift, and write its truth beside it.
     Simulate(simulate::SimulateArgs),
-    /// Print a workbench screen as text (trials, trial, compare, limits, help).
+    /// Print a workbench screen as text (trials, trial, compare, limits, help, calibration,
+    /// histogram, scatter, globe, applied, stick, heading).
     Render(render::RenderArgs),
     /// Suggest a limit table from the 90% intervals of clean trials; prints the diff.
     SuggestLimits(analysis::SuggestArgs),
     /// Mean joint angles over the first 30 s of trials, as a centroid table.
     Centroids(analysis::CentroidArgs),
-    /// Write a figure as SVG or PNG: traces or histogram.
+    /// Write a figure as SVG or PNG: traces, histogram, scatter or globe.
     Plot(plot::PlotArgs),
     /// Functional calibration of a recording (Ricci et al. 2014): rho table, residuals, calibration file.
     Calibrate(calibrate::CalibrateArgs),

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Screen: trials, trial, compare, limits, help or calibration.
+    /// Screen: trials, trial, compare, limits, help, calibration, histogram, scatter, globe,
+    /// applied, stick or heading.
     #[arg(value_parser = SCREENS)]
     pub screen: String,
     /// Folder of trials [default: ./sample_trials].
