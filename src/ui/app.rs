@@ -584,11 +584,8 @@ pub enum Msg {
     Tick,
     /// The calibration recordings of the folder, read and calibrated (protocol label).
     Calibrations(Vec<super::calibration::CalibEntry>, String),
-    /// The histograms of the histogram screen's trials over a span.
-    Histograms(
-        crate::analysis::TimeSpan,
-        Vec<crate::analysis::histogram::JointHistogram>,
-    ),
+    /// The histograms and centroids of the histogram screen's trials over a span.
+    Histograms(Box<super::histogram::Computed>),
     /// A suggested limit table or a centroid table was written (its path), or why not.
     TableWritten(Result<String, String>),
     /// A pose-calibrated version of a trial, or why there is none.
@@ -929,10 +926,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             super::calibration::loaded(app, entries, protocol);
             vec![]
         }
-        Msg::Histograms(span, hists) => {
-            super::histogram::received(app, span, hists);
-            vec![]
-        }
+        Msg::Histograms(c) => super::histogram::received(app, *c),
         Msg::TableWritten(result) => {
             super::histogram::written(app, result);
             vec![]
