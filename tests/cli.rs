@@ -216,7 +216,10 @@ fn render_reads_the_limits_folder_it_is_given() {
             "lab_limits",
         ],
     );
-    assert!(!out.status.success());
+    assert_eq!(out.status.code(), Some(3), "malformed input");
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("missing.csv"), "{err}");
+    assert!(
+        err.contains("settings.toml:1:1") && err.contains("missing.csv"),
+        "{err}"
+    );
 }

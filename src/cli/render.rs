@@ -52,6 +52,8 @@ pub fn run(a: RenderArgs, theme: &str) -> anyhow::Result<i32> {
     let limits_dir = a
         .limits_dir
         .unwrap_or_else(super::common::default_limits_dir);
+    // Read first for a located error and exit code 3 on a malformed table.
+    acm_workbench::limits::LimitsDir::load(&limits_dir)?;
     let mut app =
         load_app(&dir.display().to_string(), &dir, &limits_dir).map_err(|e| anyhow!(e))?;
     show(
