@@ -223,3 +223,40 @@ fn render_reads_the_limits_folder_it_is_given() {
         "{err}"
     );
 }
+
+#[test]
+fn writing_gyros_to_sto_warns_that_they_are_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = acmw(
+        dir.path(),
+        &[
+            "simulate",
+            "elbow",
+            "--gyro",
+            "--duration",
+            "20",
+            "-o",
+            "e.csv",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let run = |format: &str| {
+        let o = format!("out.{}", if format == "sto" { "sto" } else { "csv" });
+        let out = acmw(
+            dir.path(),
+            &["correct", "e.csv", "--format", format, "-o", &o, "--quiet"],
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    assert!(run("sto").contains("gyroscope readings are not written"));
+    assert!(!run("quat-csv").contains("gyroscope"));
+}
