@@ -37,7 +37,7 @@ fn benches(c: &mut Criterion) {
     let trials = vec![app.entry("long.csv").unwrap().loaded().unwrap().clone()];
     let table = app.limits.table.clone();
     let compute = |span| match compute_job(&trials, span, &table) {
-        Msg::Histograms(_, h) => h,
+        Msg::Histograms(h) => h,
         _ => unreachable!(),
     };
     let mut term = Terminal::new(TestBackend::new(200, 60)).unwrap();
@@ -45,16 +45,18 @@ fn benches(c: &mut Criterion) {
         "draw histogram screen, 30 min trial, first 30 s, 200x60",
         |b| b.iter(|| term.draw(|f| render(&app, &theme, f)).map(|_| ()).unwrap()),
     );
-    c.bench_function("histograms of a 30 min trial, first 30 s", |b| {
-        b.iter(|| compute(TimeSpan::FIRST_30_S))
-    });
-    c.bench_function("histograms of a 30 min trial, whole trial", |b| {
-        b.iter(|| compute(TimeSpan::WHOLE))
-    });
+    c.bench_function(
+        "histograms and centroids of a 30 min trial, first 30 s",
+        |b| b.iter(|| compute(TimeSpan::FIRST_30_S)),
+    );
+    c.bench_function(
+        "histograms and centroids of a 30 min trial, whole trial",
+        |b| b.iter(|| compute(TimeSpan::WHOLE)),
+    );
     let whole = compute(TimeSpan::WHOLE);
     if let Some(st) = app.histogram.as_mut() {
         st.span = TimeSpan::WHOLE;
-        st.hists = whole;
+        st.hists = whole.joints;
     }
     c.bench_function(
         "draw histogram screen, 30 min trial, whole trial, 200x60",

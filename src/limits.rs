@@ -203,26 +203,39 @@ impl LimitsDir {
     /// built-in files for whichever is absent. Malformed files are errors.
     pub fn load(dir: &Path) -> Result<LimitsDir, LimitsError> {
         let settings_path = dir.join("settings.toml");
-        let settings = if settings_path.exists() {
-            let origin = settings_path.display().to_string();
+        let origin = settings_path.display().to_string();
+        let (settings, text) = if settings_path.exists() {
             let text = std::fs::read_to_string(&settings_path).map_err(|e| LimitsError {
                 file: origin.clone(),
                 line: 0,
                 column: 0,
                 message: format!("cannot read: {e}"),
             })?;
-            SettingsFile::parse(&text, &origin)?
+            (SettingsFile::parse(&text, &origin)?, Some(text))
         } else {
-            SettingsFile::parse(BUILTIN_SETTINGS, "<built-in settings.toml>")?
+            let builtin = SettingsFile::parse(BUILTIN_SETTINGS, "<built-in settings.toml>")?;
+            (builtin, None)
         };
         let path = dir.join(&settings.table);
         let (table, table_source) = if path.exists() {
             (LimitTable::load(&path)?, path.display().to_string())
         } else {
-            let (name, text) = BUILTIN_TABLES
-                .iter()
-                .find(|(n, _)| *n == settings.table)
-                .unwrap_or(&BUILTIN_TABLES[0]);
+            let builtin = BUILTIN_TABLES.iter().find(|(n, _)| *n == settings.table);
+            if let (None, Some(text)) = (builtin, &text) {
+                // A table the lab named but that is nowhere: a typo must not
+                // silently correct with another table.
+                return Err(LimitsError {
+                    file: origin,
+                    line: key_line(text, "table"),
+                    column: 1,
+                    message: format!(
+                        "expected a limit table in {} or a built-in one, found no '{}'",
+                        dir.display(),
+                        settings.table
+                    ),
+                });
+            }
+            let (name, text) = builtin.unwrap_or(&BUILTIN_TABLES[0]);
             let source = format!("<built-in {name}>");
             (LimitTable::parse(text, &source)?, source)
         };
@@ -586,6 +599,17 @@ fn parse_row(
     })
 }
 
+/// 1-based line of the TOML key `key` in `text` (1 when it is not found).
+fn key_line(text: &str, key: &str) -> u64 {
+    text.lines()
+        .position(|l| {
+            l.trim_start()
+                .strip_prefix(key)
+                .is_some_and(|rest| rest.trim_start().starts_with('='))
+        })
+        .map_or(1, |i| i as u64 + 1)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -713,6 +737,25 @@ mod tests {
         std::fs::write(dir.path().join("mine.csv"), "joint,axis\n").unwrap();
         let e = LimitsDir::load(dir.path()).unwrap_err();
         assert!(e.file.ends_with("mine.csv") && e.line == 1, "{e}");
+        // A table named in settings.toml that is neither in the folder nor
+        // built in is an error at the `table` line, not a silent fallback.
+        std::fs::remove_file(dir.path().join("mine.csv")).unwrap();
+        std::fs::write(
+            dir.path().join("settings.toml"),
+            "lambda1 = 0.1\nwindow_s = 40.0\n  table = \"mine.csv\"\nhop_s = 20.0\n",
+        )
+        .unwrap();
+        let e = LimitsDir::load(dir.path()).unwrap_err();
+        assert!(e.file.ends_with("settings.toml") && e.line == 3, "{e}");
+        assert!(e.message.contains("'mine.csv'"), "{e}");
+        // A built-in name missing from the folder is the built-in table.
+        std::fs::write(
+            dir.path().join("settings.toml"),
+            "table = \"table_3_1.csv\"\nlambda1 = 0.1\nwindow_s = 40.0\nhop_s = 20.0\n",
+        )
+        .unwrap();
+        let d = LimitsDir::load(dir.path()).unwrap();
+        assert_eq!(d.table_source, "<built-in table_3_1.csv>");
     }
 
     #[test]

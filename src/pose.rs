@@ -211,7 +211,9 @@ fn samples(trial: &Trial, at: PoseTime) -> Result<Vec<usize>, PoseError> {
 
 /// Calibrates `trial` to `model`'s default pose: returns the calibrated trial
 /// (segment orientations, heading-corrected; IMUs the model does not know are
-/// only heading-corrected) and the record of what was found.
+/// only heading-corrected) and the record of what was found. Gyroscope
+/// readings, if any, are re-expressed in the segment frames (`w' = O w`, O the
+/// IMU's offset; the heading turn leaves sensor-frame rates unchanged).
 pub fn calibrate(
     trial: &Trial,
     model: &Model,
@@ -252,6 +254,11 @@ pub fn calibrate(
                 Some(oi) => Quat::new_normalize((g * oi).into_inner()),
                 None => g,
             };
+        }
+        // The heading turns the global frame (no change to sensor-frame
+        // rates); the offset turns the sensor frame.
+        if let Some(oi) = offset_inv {
+            series.turn_gyro(&oi);
         }
     }
     Ok((

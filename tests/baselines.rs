@@ -167,7 +167,7 @@ fn elbow_case(cfg: &SimConfig) -> (f64, f64, [f64; 3], [f64; 3]) {
     let sim = simulate(cfg).unwrap();
     let c = run(&sim.trial, Variant::Mueller);
     let j = c.joint("l_elbow").unwrap();
-    let Some(BaselineRecord::Mueller { fit: Some(fit) }) = &j.baseline else {
+    let Some(BaselineRecord::Mueller { fit: Some(fit), .. }) = &j.baseline else {
         panic!("no axes estimated")
     };
     let ma = sim.truth.meta.misalignment("l_upper_arm").unwrap();

@@ -49,6 +49,10 @@ fn baselines_correct_reproduce_and_report() {
             if name.ends_with(kind) {
                 assert_eq!(j["baseline"]["method"], variant, "{name}");
                 assert!(!j["baseline"][key].is_null(), "{name}");
+                if variant == "mueller" {
+                    // No gyroscope columns in this trial.
+                    assert_eq!(j["baseline"]["rates"], "orientations", "{name}");
+                }
             } else {
                 assert!(j.get("baseline").is_none(), "{name} has a baseline");
             }
@@ -90,4 +94,74 @@ fn baselines_correct_reproduce_and_report() {
         text.contains("rivest") && text.contains("mueller"),
         "{text}"
     );
+}
+
+/// An elbow simulated with gyroscope columns: Mueller takes its rates from them
+/// and says so in the sidecar; the sidecar reproduces the output byte for byte,
+/// and so does one written before the `rates` field existed.
+#[test]
+fn mueller_with_gyro_columns_records_and_reproduces() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    acmw(
+        d,
+        &[
+            "simulate",
+            "elbow",
+            "--duration",
+            "60",
+            "--gyro",
+            "--gyro-noise",
+            "1",
+            "-o",
+            "e.csv",
+        ],
+    );
+    acmw(d, &["correct", "e.csv", "--variant", "mueller", "--quiet"]);
+    let first = d.join("corrected/e.mueller.csv");
+    let sidecar = d.join("corrected/e.mueller.csv.acmw.json");
+    let text = std::fs::read_to_string(&sidecar).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let elbow = json["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|j| j["joint"] == "l_elbow")
+        .unwrap();
+    assert_eq!(elbow["baseline"]["rates"], "gyroscopes");
+    assert!(!elbow["baseline"]["fit"].is_null());
+    // The corrected trial keeps gyroscope columns (in the corrected frames).
+    let out = std::fs::read_to_string(&first).unwrap();
+    assert!(
+        out.lines().next().unwrap().contains("l_forearm_gx"),
+        "{}",
+        &out[..200]
+    );
+    let mut old: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for j in old["joints"].as_array_mut().unwrap() {
+        if let Some(b) = j.get_mut("baseline").and_then(|b| b.as_object_mut()) {
+            b.remove("rates");
+        }
+    }
+    let old_path = d.join("old.json");
+    std::fs::write(&old_path, serde_json::to_string_pretty(&old).unwrap()).unwrap();
+    for (sc, out) in [(&sidecar, "again.csv"), (&old_path, "again_old.csv")] {
+        acmw(
+            d,
+            &[
+                "correct",
+                "e.csv",
+                "--from-sidecar",
+                sc.to_str().unwrap(),
+                "-o",
+                out,
+                "--quiet",
+            ],
+        );
+        assert_eq!(
+            std::fs::read(&first).unwrap(),
+            std::fs::read(d.join(out)).unwrap(),
+            "{out}"
+        );
+    }
 }

@@ -164,3 +164,99 @@ fn output_into_a_closed_pipe_is_not_a_panic() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(out.status.code(), Some(0), "{err}");
 }
+
+#[test]
+fn render_reads_the_limits_folder_it_is_given() {
+    // A lab keeps its tables elsewhere: `--limits-dir` names the folder; the
+    // default is ./joint_limits, else the built-in tables.
+    let dir = tempfile::tempdir().unwrap();
+    simulated(dir.path());
+    let lab = dir.path().join("lab_limits");
+    std::fs::create_dir(&lab).unwrap();
+    std::fs::write(
+        lab.join("settings.toml"),
+        "table = \"ours.csv\"\nlambda1 = 0.07\nwindow_s = 40.0\nhop_s = 20.0\n",
+    )
+    .unwrap();
+    let table = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("joint_limits/table_3_2.csv"),
+    )
+    .unwrap();
+    std::fs::write(lab.join("ours.csv"), table).unwrap();
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", "limits", "--dir", ".", "--size", "120x40"];
+        args.extend_from_slice(extra);
+        let out = acmw(dir.path(), &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let theirs = render(&["--limits-dir", "lab_limits"]);
+    assert!(theirs.contains("ours.csv"), "{theirs}");
+    assert!(theirs.contains("0.07") && theirs.contains("40"), "{theirs}");
+    let default = render(&[]);
+    assert!(!default.contains("ours.csv"), "{default}");
+    // A folder that does not hold what it should is an error, not a silent fallback.
+    std::fs::write(
+        lab.join("settings.toml"),
+        "table = \"missing.csv\"\nlambda1 = 0.07\nwindow_s = 40.0\nhop_s = 20.0\n",
+    )
+    .unwrap();
+    let out = acmw(
+        dir.path(),
+        &[
+            "render",
+            "limits",
+            "--dir",
+            ".",
+            "--limits-dir",
+            "lab_limits",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(3), "malformed input");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("settings.toml:1:1") && err.contains("missing.csv"),
+        "{err}"
+    );
+}
+
+#[test]
+fn writing_gyros_to_sto_warns_that_they_are_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = acmw(
+        dir.path(),
+        &[
+            "simulate",
+            "elbow",
+            "--gyro",
+            "--duration",
+            "20",
+            "-o",
+            "e.csv",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let run = |format: &str| {
+        let o = format!("out.{}", if format == "sto" { "sto" } else { "csv" });
+        let out = acmw(
+            dir.path(),
+            &["correct", "e.csv", "--format", format, "-o", &o, "--quiet"],
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    assert!(run("sto").contains("gyroscope readings are not written"));
+    assert!(!run("quat-csv").contains("gyroscope"));
+}

@@ -343,3 +343,88 @@ fn wide_csv_with_time_s_reads_with_the_16_segment_model() {
     let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
     assert!(names.contains(&"l_wrist") && names.contains(&"lumbar") && names.contains(&"thoracic"));
 }
+
+/// `text` (an [`export`] of `counters`) with MT Manager's `Gyr_X Gyr_Y Gyr_Z`
+/// after `Acc_Z`: per packet `(counter / 1000, id, -counter / 1000)` rad/s
+/// (unwrapped counter), so every reading says which packet it came from.
+fn with_gyros(text: &str, counters: &[u64], id: f64) -> String {
+    let mut rows = counters.iter();
+    let mut out = String::new();
+    for line in text.lines() {
+        if line.starts_with("//") {
+            out.push_str(line);
+        } else if line.starts_with("PacketCounter") {
+            out.push_str(&line.replace("Acc_Z", "Acc_Z\tGyr_X\tGyr_Y\tGyr_Z"));
+        } else {
+            let c = *rows.next().unwrap() as f64 / 1000.0;
+            let mut cells: Vec<String> = line.split('\t').map(str::to_string).collect();
+            cells.insert(6, format!("{c}\t{id}\t{}", -c));
+            out.push_str(&cells.join("\t"));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+#[test]
+fn xsens_gyroscope_columns_stay_aligned_with_the_orientations() {
+    let dir = tempfile::tempdir().unwrap();
+    let sensors = sensors();
+    write_recording(dir.path(), "IMUData", &sensors, None);
+    // Pelvis and tibia (which misses packets) get gyros, the femur none.
+    for (s, id) in [(&sensors[0], 1.0), (&sensors[2], 3.0)] {
+        let f = dir
+            .path()
+            .join(format!("IMUData/MT_TEST-001_{}.txt", s.serial));
+        let text = std::fs::read_to_string(&f).unwrap();
+        std::fs::write(&f, with_gyros(&text, &s.counters, id)).unwrap();
+    }
+    let model = Model::builtin("opensense_lower").unwrap();
+    let trial = read_trial(&dir.path().join("myIMUMappings.xml"), &model).unwrap();
+    let kept: Vec<u64> = (65533..=65560)
+        .filter(|c| !(65540..=65542).contains(c))
+        .collect();
+    assert_eq!(trial.len(), kept.len());
+    assert!(trial.imu("femur_r_imu").unwrap().gyro.is_none());
+    for (s, id) in [(&sensors[0], 1.0), (&sensors[2], 3.0)] {
+        let series = trial.imu(s.name).unwrap();
+        let g = series.gyro.as_ref().expect("gyros read");
+        assert_eq!(g.len(), kept.len());
+        for (k, c) in kept.iter().enumerate() {
+            // The reading of packet c sits beside the orientation of packet c.
+            let want = *c as f64 / 1000.0;
+            assert_eq!(
+                (g[k].x, g[k].y, g[k].z),
+                (want, id, -want),
+                "{} {c}",
+                s.name
+            );
+            let i = s.counters.iter().position(|x| x == c).unwrap();
+            assert_quat_eq(&series.orientation[k], &s.qs[i], s.name);
+        }
+    }
+    // Two of the three columns: an error at the header's first gyro column.
+    let f = dir.path().join("IMUData/MT_TEST-001_00B42279.txt");
+    let text = std::fs::read_to_string(&f).unwrap();
+    std::fs::write(&f, text.replace("\tGyr_Z", "\tGyr_Q")).unwrap();
+    let e = read_trial(&dir.path().join("myIMUMappings.xml"), &model).unwrap_err();
+    assert_eq!(
+        (e.file.as_str(), e.line, e.column),
+        (f.to_str().unwrap(), 6, 7),
+        "{e}"
+    );
+    assert!(
+        e.message
+            .contains("missing Gyr_Z; expected all of Gyr_X, Gyr_Y, Gyr_Z (rad/s, sensor frame)"),
+        "{e}"
+    );
+    // A bad reading names its line and column.
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut cells: Vec<String> = lines[9].split('\t').map(str::to_string).collect();
+    cells[7] = "fast".into();
+    lines[9] = cells.join("\t");
+    std::fs::write(&f, lines.join("\n")).unwrap();
+    let e = read_trial(&dir.path().join("myIMUMappings.xml"), &model).unwrap_err();
+    assert_eq!((e.line, e.column), (10, 8), "{e}");
+    assert!(e.message.contains("Gyr_Y, found 'fast'"), "{e}");
+}

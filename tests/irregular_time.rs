@@ -11,25 +11,13 @@ use acm_workbench::rotation::{angle_between_deg, quat_axis_angle_deg, quat_from_
 use acm_workbench::simulate::{simulate, SimConfig};
 use acm_workbench::trial::glitch::{glitches, DEFAULT_GLITCH_DEG};
 use acm_workbench::trial::timing::timing;
-use acm_workbench::trial::{read_trial, write_trial, ImuSeries, Trial, TrialFormat};
+use acm_workbench::trial::{read_trial, write_trial, Trial, TrialFormat};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// The samples `idx` of `t`.
 fn pick(t: &Trial, idx: &[usize], name: &str) -> Trial {
-    Trial {
-        name: name.into(),
-        time_s: idx.iter().map(|&i| t.time_s[i]).collect(),
-        imus: t
-            .imus
-            .iter()
-            .map(|s| ImuSeries {
-                name: s.name.clone(),
-                orientation: idx.iter().map(|&i| s.orientation[i]).collect(),
-            })
-            .collect(),
-        warnings: vec![],
-    }
+    t.select(idx, name)
 }
 
 /// One full-body motion (13 IMUs, 5-30 deg misalignments, 0.3 deg noise),

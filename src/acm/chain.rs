@@ -4,6 +4,16 @@
 //! the chain never depend on each other and run in parallel, as do the windows
 //! of one joint; every window's result depends only on its inputs, so the output
 //! is bit-identical for any thread count.
+//!
+//! Gyroscope readings (sensor frame) follow their IMU's correction: a distal IMU
+//! corrected by the ACM as `G_R_dist C(t)` reads `C(t)^-1 w` in its corrected
+//! frame (heading fits, `Rz(-h(t)) G_R_dist C`, likewise with their constant
+//! C); the correction's own rate (C changes over tens of seconds, h at
+//! fractions of a degree per second) is left out. A baseline's `C(t)` turns
+//! with the joint: the baseline gives the corrected readings itself (Mueller,
+//! from both IMUs' gyros) or they are dropped (Rivest). The Mueller baseline
+//! takes its proximal gyros from the corrected trial, so they are in the frame
+//! its joint rotations are measured from.
 
 use super::cost::WindowCost;
 use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
@@ -19,6 +29,7 @@ use crate::limits::{JointLimits, LimitTable, Settings};
 use crate::model::{Joint, Model};
 use crate::rotation::{angle_deg, canonical, quat_from_wxyz, wxyz, Quat};
 use crate::trial::Trial;
+use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::collections::{BTreeSet, HashMap};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -160,13 +171,16 @@ fn run(
                         if let Some(r) = prev.joint(&joint.name) {
                             let kept = prev.corrected.imu(&joint.distal).expect("present");
                             let heading = prev.heading(&joint.distal).cloned();
-                            let applied = Applied::Kept(kept.orientation.clone());
+                            let applied =
+                                Applied::Kept(kept.orientation.clone(), kept.gyro.clone());
                             return Ok((*k, r.clone(), applied, heading));
                         }
                     }
                 }
-                let parent = &corrected.imu(&joint.proximal).expect("present").orientation;
-                let child = &trial.imu(&joint.distal).expect("present").orientation;
+                let parent_series = corrected.imu(&joint.proximal).expect("present");
+                let child_series = trial.imu(&joint.distal).expect("present");
+                let parent = &parent_series.orientation;
+                let child = &child_series.orientation;
                 let progress = || {
                     let d = done.fetch_add(1, Ordering::Relaxed) + 1;
                     if let Some(p) = control.progress {
@@ -212,7 +226,10 @@ fn run(
                     let (sol, heading, orientation) =
                         solve_heading(&trial.time_s, &lookahead, &joint.name, &joint.distal);
                     windows.iter().for_each(|_| progress());
-                    let applied = Applied::Kept(orientation);
+                    let c_inv = quat_from_wxyz(heading.correction).inverse();
+                    let gyro =
+                        (child_series.gyro.as_ref()).map(|g| g.iter().map(|w| c_inv * w).collect());
+                    let applied = Applied::Kept(orientation, gyro);
                     return Ok((*k, result(sol, None), applied, Some(heading)));
                 }
                 let measured: Vec<Quat> = parent
@@ -220,30 +237,35 @@ fn run(
                     .zip(child)
                     .map(|(p, c)| p.inverse() * c)
                     .collect();
-                let (sol, baseline) = match baselines::method_for(variant, &joint.kind) {
-                    Some(method) => solve_baseline(
+                let gyros = match (&parent_series.gyro, &child_series.gyro) {
+                    (Some(p), Some(c)) => Some(baselines::JointGyros {
+                        proximal: p,
+                        distal: c,
+                    }),
+                    _ => None,
+                };
+                if let Some(method) = baselines::method_for(variant, &joint.kind) {
+                    let (sol, baseline, gyro) = solve_baseline(
                         method,
-                        &trial.time_s,
-                        &measured,
+                        (&trial.time_s, &measured, gyros),
                         &windows,
                         control,
                         &progress,
-                    )?,
-                    None => (
-                        solve_windows(
-                            &trial.time_s,
-                            &measured,
-                            &windows,
-                            lim,
-                            settings.lambda1,
-                            control,
-                            &progress,
-                        )?,
-                        None,
-                    ),
-                };
+                    )?;
+                    let applied = Applied::Baseline(sol.series, gyro);
+                    return Ok((*k, result(sol.windows, baseline), applied, None));
+                }
+                let sol = solve_windows(
+                    &trial.time_s,
+                    &measured,
+                    &windows,
+                    lim,
+                    settings.lambda1,
+                    control,
+                    &progress,
+                )?;
                 let applied = Applied::Series(sol.series);
-                Ok((*k, result(sol.windows, baseline), applied, None))
+                Ok((*k, result(sol.windows, None), applied, None))
             })
             .collect::<Result<_, Cancelled>>()?;
         for (k, result, applied, heading) in solved {
@@ -257,8 +279,22 @@ fn run(
                     for (q, c) in imu.orientation.iter_mut().zip(&series) {
                         *q = Quat::new_normalize((*q * c).into_inner());
                     }
+                    if let Some(g) = &mut imu.gyro {
+                        for (w, c) in g.iter_mut().zip(&series) {
+                            *w = c.inverse() * *w;
+                        }
+                    }
                 }
-                Applied::Kept(orientation) => imu.orientation = orientation,
+                Applied::Baseline(series, gyro) => {
+                    for (q, c) in imu.orientation.iter_mut().zip(&series) {
+                        *q = Quat::new_normalize((*q * c).into_inner());
+                    }
+                    imu.gyro = gyro;
+                }
+                Applied::Kept(orientation, gyro) => {
+                    imu.orientation = orientation;
+                    imu.gyro = gyro;
+                }
             }
             results.insert(k, result);
         }
@@ -282,13 +318,19 @@ fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &s
     results.keys().any(|&k| model.joints[k].distal == imu)
 }
 
+/// A baseline's corrected distal gyros (`None`: dropped).
+type BaselineGyro = Option<Vec<Vector3<f64>>>;
+
 /// What a joint's run gives its distal IMU.
 enum Applied {
-    /// A fresh per-sample correction `C(t)`, to apply as `G_R_dist * C(t)`.
+    /// A fresh per-sample correction `C(t)`, to apply as `G_R_dist * C(t)`
+    /// (and `C(t)^-1 w` to the gyros).
     Series(Vec<Quat>),
-    /// Corrected orientations to take as they are (a heading fit, or an
-    /// earlier run's kept result).
-    Kept(Vec<Quat>),
+    /// A baseline's `C(t)`, applied likewise, and the gyros to take instead.
+    Baseline(Vec<Quat>, BaselineGyro),
+    /// Corrected orientations and gyroscope readings to take as they are (a
+    /// heading fit, or an earlier run's kept result).
+    Kept(Vec<Quat>, Option<Vec<Vector3<f64>>>),
 }
 
 /// Fits the heading model of one joint's distal IMU: the window solutions (each
@@ -343,25 +385,32 @@ fn solve_heading(
     (windows, heading, orientation)
 }
 
-/// Solves one joint with a baseline method (Rivest, Mueller) instead of the ACM.
+/// Solves one joint with a baseline method (Rivest, Mueller) instead of the ACM,
+/// from the sample times, the measured joint rotations and the joint's gyros.
 fn solve_baseline(
     method: baselines::Method,
-    time_s: &[f64],
-    measured: &[Quat],
+    (time_s, measured, gyros): (&[f64], &[Quat], Option<baselines::JointGyros>),
     windows: &[Window],
     control: &RunControl,
     progress: &(dyn Fn() + Sync),
-) -> Result<(JointSolution, Option<baselines::BaselineRecord>), Cancelled> {
+) -> Result<
+    (
+        JointSolution,
+        Option<baselines::BaselineRecord>,
+        BaselineGyro,
+    ),
+    Cancelled,
+> {
     if control.cancelled() {
         return Err(Cancelled);
     }
-    let b = baselines::solve_joint(method, time_s, measured, windows);
+    let b = baselines::solve_joint(method, time_s, measured, gyros, windows);
     windows.iter().for_each(|_| progress());
     let sol = JointSolution {
         windows: b.windows,
         series: b.series,
     };
-    Ok((sol, Some(b.record)))
+    Ok((sol, Some(b.record), b.gyro))
 }
 
 /// Solves one joint: the measured joint rotations `Rm_i` (parent' to child), per sample.

@@ -10,6 +10,10 @@
 //! corrections are carried by the distal IMU: `G_R_dist' = G_R_prox' Rt'`, with
 //! `Rt'` the baseline's corrected joint rotation. As a per-sample correction of
 //! the distal IMU that is `C(t) = Rm(t)^-1 Rt'(t)`.
+//!
+//! Mueller needs angular rates: from the two IMUs' gyroscope readings when the
+//! trial has them for both ([`JointGyros`]), else derived from the
+//! orientations; the record says which ([`RateSource`]).
 
 pub mod mueller;
 pub mod rivest;
@@ -17,7 +21,10 @@ pub mod rivest;
 use crate::acm::window::{between_centres, Window};
 use crate::acm::{Variant, WindowSolution};
 use crate::rotation::{angle_deg, canonical, euler_zyx_deg, quat_from_euler_zyx_deg, wxyz, Quat};
-use mueller::{estimate_axes, rates_from_orientations, MuellerFit, MuellerOptions};
+use mueller::{
+    estimate_axes, rates_from_gyros, rates_from_orientations, MuellerFit, MuellerOptions,
+};
+use nalgebra::Vector3;
 use rivest::RivestFit;
 use serde::{Deserialize, Serialize};
 
@@ -50,6 +57,28 @@ pub fn method_for(variant: Variant, kind: &str) -> Option<Method> {
     (m.joint_kind() == kind).then_some(m)
 }
 
+/// Where Mueller's angular rates came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RateSource {
+    /// The two IMUs' gyroscope readings (each in its sensor frame).
+    Gyroscopes,
+    /// Central differences of the measured joint rotations (the only source
+    /// before trials carried gyros, hence the default of older sidecars).
+    #[default]
+    Orientations,
+}
+
+/// The gyroscope readings of a joint's two IMUs, rad/s, one per sample:
+/// `proximal` in the frame the measured joint rotations are taken from (the
+/// proximal IMU as corrected by its parent joint), `distal` in the distal
+/// IMU's sensor frame.
+#[derive(Debug, Clone, Copy)]
+pub struct JointGyros<'a> {
+    pub proximal: &'a [Vector3<f64>],
+    pub distal: &'a [Vector3<f64>],
+}
+
 /// What a baseline found for one joint (kept in the sidecar).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "method", rename_all = "kebab-case")]
@@ -59,7 +88,13 @@ pub enum BaselineRecord {
     Rivest { fits: Vec<RivestFit> },
     /// Mueller's axes (one estimate for the whole trial); `None` when the joint
     /// moved too little to estimate them (the joint is then left as measured).
-    Mueller { fit: Option<MuellerFit> },
+    /// `rates` says where the angular rates came from (sidecars written before
+    /// gyroscope support lack it and read as `orientations`).
+    Mueller {
+        fit: Option<MuellerFit>,
+        #[serde(default)]
+        rates: RateSource,
+    },
 }
 
 /// A baseline's solution of one joint.
@@ -75,20 +110,28 @@ pub struct BaselineSolution {
     /// `C(t)` per sample (sensor frame of the distal IMU).
     pub series: Vec<Quat>,
     pub record: BaselineRecord,
+    /// The distal IMU's gyroscope readings in its corrected frame (rad/s), when
+    /// the method can tell them: Mueller from both IMUs' gyros. `None`
+    /// otherwise: `C(t)` turns with the joint, so the recorded readings no
+    /// longer describe the corrected orientation and are dropped.
+    pub gyro: Option<Vec<Vector3<f64>>>,
 }
 
 /// Solves one joint with `method` from the measured joint rotations `Rm_i`
 /// (parent' to child). Rivest fits each of `windows`; Mueller fits the whole
-/// trial once (the axes are fixed in the sensors) and reports it per window.
+/// trial once (the axes are fixed in the sensors) and reports it per window,
+/// with rates from `gyros` when given (one reading per sample for both IMUs),
+/// else derived from `measured`. Rivest ignores `gyros`.
 pub fn solve_joint(
     method: Method,
     time_s: &[f64],
     measured: &[Quat],
+    gyros: Option<JointGyros>,
     windows: &[Window],
 ) -> BaselineSolution {
     match method {
         Method::Rivest => solve_rivest(time_s, measured, windows),
-        Method::Mueller => solve_mueller(time_s, measured, windows),
+        Method::Mueller => solve_mueller(time_s, measured, gyros, windows),
     }
 }
 
@@ -118,12 +161,56 @@ fn solve_rivest(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> Baseli
         windows: windows_out,
         series,
         record: BaselineRecord::Rivest { fits },
+        gyro: None,
     }
 }
 
-fn solve_mueller(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> BaselineSolution {
+/// Relative rates (rad/s, proximal frame) for Mueller and where they came
+/// from: the gyros when both IMUs have one per sample, else the orientations.
+fn mueller_rates(
+    time_s: &[f64],
+    measured: &[Quat],
+    gyros: Option<JointGyros>,
+    opts: &MuellerOptions,
+) -> (Vec<Vector3<f64>>, RateSource) {
+    match gyros {
+        Some(g) if g.proximal.len() == measured.len() && g.distal.len() == measured.len() => (
+            rates_from_gyros(measured, g.proximal, g.distal),
+            RateSource::Gyroscopes,
+        ),
+        _ => (
+            rates_from_orientations(time_s, measured, opts.rate_half_span_s),
+            RateSource::Orientations,
+        ),
+    }
+}
+
+/// The distal IMU's gyros after Mueller's correction: as recorded when no
+/// axes were found (no correction), from both IMUs' gyros through
+/// [`MuellerFit::corrected_distal_rates`] when they were, `None` without gyros.
+fn mueller_corrected_gyro(
+    fit: Option<&MuellerFit>,
+    measured: &[Quat],
+    gyros: Option<JointGyros>,
+) -> Option<Vec<Vector3<f64>>> {
+    let g = gyros?;
+    if g.proximal.len() != measured.len() || g.distal.len() != measured.len() {
+        return None;
+    }
+    Some(match fit {
+        None => g.distal.to_vec(),
+        Some(f) => f.corrected_distal_rates(measured, g.proximal, g.distal),
+    })
+}
+
+fn solve_mueller(
+    time_s: &[f64],
+    measured: &[Quat],
+    gyros: Option<JointGyros>,
+    windows: &[Window],
+) -> BaselineSolution {
     let opts = MuellerOptions::default();
-    let rates = rates_from_orientations(time_s, measured, opts.rate_half_span_s);
+    let (rates, source) = mueller_rates(time_s, measured, gyros, &opts);
     let fit = estimate_axes(measured, &rates, &opts);
     let series: Vec<Quat> = match &fit {
         Some(f) => measured
@@ -142,7 +229,8 @@ fn solve_mueller(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> Basel
     BaselineSolution {
         windows: windows_out,
         series,
-        record: BaselineRecord::Mueller { fit },
+        gyro: mueller_corrected_gyro(fit.as_ref(), measured, gyros),
+        record: BaselineRecord::Mueller { fit, rates: source },
     }
 }
 
@@ -194,6 +282,31 @@ mod tests {
     use crate::rotation::quat_axis_angle_deg;
 
     #[test]
+    fn mueller_records_say_where_the_rates_came_from_and_old_ones_still_load() {
+        let new = BaselineRecord::Mueller {
+            fit: None,
+            rates: RateSource::Gyroscopes,
+        };
+        let json = serde_json::to_string(&new).unwrap();
+        assert_eq!(
+            json,
+            r#"{"method":"mueller","fit":null,"rates":"gyroscopes"}"#
+        );
+        let back: BaselineRecord = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, new);
+        // Written before gyroscope support: no "rates", which were orientations.
+        let old: BaselineRecord =
+            serde_json::from_str(r#"{"method":"mueller","fit":null}"#).unwrap();
+        assert_eq!(
+            old,
+            BaselineRecord::Mueller {
+                fit: None,
+                rates: RateSource::Orientations
+            }
+        );
+    }
+
+    #[test]
     fn only_the_methods_joint_kind_gets_the_baseline() {
         assert_eq!(method_for(Variant::Rivest, "knee"), Some(Method::Rivest));
         assert_eq!(method_for(Variant::Rivest, "elbow"), None);
@@ -218,7 +331,7 @@ mod tests {
             })
             .collect();
         let windows = layout(&time_s, 60.0, 30.0);
-        let sol = solve_joint(Method::Rivest, &time_s, &measured, &windows);
+        let sol = solve_joint(Method::Rivest, &time_s, &measured, None, &windows);
         let BaselineRecord::Rivest { fits } = &sol.record else {
             panic!("rivest record")
         };
@@ -232,7 +345,13 @@ mod tests {
         // Half-way between the centres of windows 2 and 3 (at 75 s and 105 s).
         let mid = fits[2].lerp(&fits[3], 0.5);
         assert!((mid.b2 - 0.5 * (fits[2].b2 + fits[3].b2)).abs() < 1e-12);
-        let one = solve_joint(Method::Rivest, &time_s, &measured, &whole_trial(&time_s));
+        let one = solve_joint(
+            Method::Rivest,
+            &time_s,
+            &measured,
+            None,
+            &whole_trial(&time_s),
+        );
         assert_eq!(one.windows.len(), 1);
     }
 }

@@ -363,6 +363,27 @@ impl MuellerFit {
         let (cp, cd) = self.corrections();
         cp * rm * cd.inverse()
     }
+
+    /// The distal IMU's angular rate (rad/s) in its corrected frame, when its
+    /// orientation becomes `G_R_prox Rt'` with `Rt' = C_prox Rm C_dist^-1`
+    /// (both corrections carried by the distal IMU): from the gyros `w_p`
+    /// (proximal frame) and `w_d` (distal frame),
+    /// `w' = C_dist (w_d + Rm^-1 (C_prox^-1 w_p - w_p))`; exact, no derivative
+    /// of the orientations taken.
+    pub fn corrected_distal_rates(
+        &self,
+        rm: &[Quat],
+        w_p: &[Vector3<f64>],
+        w_d: &[Vector3<f64>],
+    ) -> Vec<Vector3<f64>> {
+        let (cp, cd) = self.corrections();
+        let cp_inv = cp.inverse();
+        rm.iter()
+            .zip(w_p)
+            .zip(w_d)
+            .map(|((r, p), d)| cd * (d + r.inverse() * (cp_inv * p - p)))
+            .collect()
+    }
 }
 
 #[cfg(test)]

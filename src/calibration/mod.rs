@@ -405,15 +405,19 @@ impl AppliedCalibration {
     }
 
     /// Applies the rotations to the trial in place: `G_R_FF = G_R_SF * R^-1` for
-    /// every calibrated IMU the trial has (names through the model's aliases).
-    /// Returns warnings for calibrated IMUs the trial lacks.
+    /// every calibrated IMU the trial has (names through the model's aliases),
+    /// and its gyroscope readings, if any, re-expressed in the functional
+    /// frame (`w_FF = R w_SF`, rad/s). Returns warnings for calibrated IMUs the trial lacks.
     pub fn apply(&self, trial: &mut Trial, model: &Model) -> Vec<String> {
         let mut warnings = vec![];
         for a in &self.imus {
             let name = model.canonical_imu(&a.imu).unwrap_or(&a.imu).to_string();
             let inv = quat_from_wxyz(a.q).inverse();
             match trial.imu_mut(&name) {
-                Some(s) => s.orientation.iter_mut().for_each(|o| *o *= inv),
+                Some(s) => {
+                    s.orientation.iter_mut().for_each(|o| *o *= inv);
+                    s.turn_gyro(&inv);
+                }
                 None => warnings.push(format!(
                     "calibration {}: IMU '{}' is not in trial {}",
                     self.file, a.imu, trial.name

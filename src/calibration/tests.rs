@@ -219,10 +219,10 @@ fn applying_the_calibration_gives_the_segment_orientation() {
     let mut trial = Trial {
         name: "t".into(),
         time_s: vec![0.0, 0.02],
-        imus: vec![crate::trial::ImuSeries {
-            name: "l_forearm".into(),
-            orientation: seg.iter().map(|s| s * m).collect(),
-        }],
+        imus: vec![crate::trial::ImuSeries::new(
+            "l_forearm",
+            seg.iter().map(|s| s * m).collect(),
+        )],
         warnings: vec![],
     };
     let applied = AppliedCalibration {

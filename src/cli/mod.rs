@@ -56,6 +56,10 @@ pub struct Cli {
     pub command: Option<Command>,
     /// Folder of trials to open in the workbench (default: ./sample_trials).
     pub dir: Option<PathBuf>,
+    /// Folder of limit tables and settings.toml the workbench reads and saves
+    /// [default: ./joint_limits; the built-in tables when it has none].
+    #[arg(long, value_name = "DIR")]
+    pub limits_dir: Option<PathBuf>,
     /// Colour theme of the workbench: dark, light or high-contrast (NO_COLOR is honoured).
     #[arg(long, global = true, default_value = "dark")]
     pub theme: String,
@@ -69,13 +73,14 @@ pub enum Command {
     Report(report::ReportArgs),
     /// Simulate a trial with known misalignment and drift, and write its truth beside it.
     Simulate(simulate::SimulateArgs),
-    /// Print a workbench screen as text (trials, trial, compare, limits, help).
+    /// Print a workbench screen as text (trials, trial, compare, limits, help, calibration,
+    /// histogram, scatter, globe, applied, stick, heading).
     Render(render::RenderArgs),
     /// Suggest a limit table from the 90% intervals of clean trials; prints the diff.
     SuggestLimits(analysis::SuggestArgs),
     /// Mean joint angles over the first 30 s of trials, as a centroid table.
     Centroids(analysis::CentroidArgs),
-    /// Write a figure as SVG or PNG: traces or histogram.
+    /// Write a figure as SVG or PNG: traces, histogram, scatter or globe.
     Plot(plot::PlotArgs),
     /// Functional calibration of a recording (Ricci et al. 2014): rho table, residuals, calibration file.
     Calibrate(calibrate::CalibrateArgs),
@@ -92,7 +97,7 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::Centroids(a)) => analysis::run_centroids(a),
         Some(Command::Plot(a)) => plot::run(a),
         Some(Command::Calibrate(a)) => calibrate::run(a),
-        None => workbench(cli.dir, &cli.theme),
+        None => workbench(cli.dir, &cli.theme, cli.limits_dir),
     };
     match result {
         Ok(code) => code,
@@ -118,7 +123,11 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 }
 
 /// Bare `acmw`: the terminal workbench, when there is a terminal.
-fn workbench(dir: Option<PathBuf>, theme: &str) -> anyhow::Result<i32> {
+fn workbench(
+    dir: Option<PathBuf>,
+    theme: &str,
+    limits_dir: Option<PathBuf>,
+) -> anyhow::Result<i32> {
     use std::io::IsTerminal;
     if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
         eprintln!(
@@ -131,7 +140,7 @@ fn workbench(dir: Option<PathBuf>, theme: &str) -> anyhow::Result<i32> {
         acm_workbench::ui::theme::Theme::builtin(theme, no_color).map_err(anyhow::Error::msg)?;
     acm_workbench::ui::runtime::run(acm_workbench::ui::runtime::Options {
         dir: dir.unwrap_or_else(|| PathBuf::from("sample_trials")),
-        limits_dir: common::default_limits_dir(),
+        limits_dir: limits_dir.unwrap_or_else(common::default_limits_dir),
         theme,
     })?;
     Ok(EXIT_OK)

@@ -10,12 +10,16 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Screen: trials, trial, compare, limits, help or calibration.
+    /// Screen: trials, trial, compare, limits, help, calibration, histogram, scatter, globe,
+    /// applied, stick or heading.
     #[arg(value_parser = SCREENS)]
     pub screen: String,
     /// Folder of trials [default: ./sample_trials].
     #[arg(long)]
     pub dir: Option<PathBuf>,
+    /// Folder of limit tables and settings.toml [default: ./joint_limits].
+    #[arg(long, value_name = "DIR")]
+    pub limits_dir: Option<PathBuf>,
     /// Trial file name inside the folder [default: the first readable one].
     #[arg(long)]
     pub trial: Option<String>,
@@ -45,12 +49,13 @@ pub fn run(a: RenderArgs, theme: &str) -> anyhow::Result<i32> {
     let dir = a.dir.unwrap_or_else(|| PathBuf::from("sample_trials"));
     let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
     let theme = Theme::builtin(theme, no_color).map_err(|e| anyhow!(e))?;
-    let mut app = load_app(
-        &dir.display().to_string(),
-        &dir,
-        &super::common::default_limits_dir(),
-    )
-    .map_err(|e| anyhow!(e))?;
+    let limits_dir = a
+        .limits_dir
+        .unwrap_or_else(super::common::default_limits_dir);
+    // Read first for a located error and exit code 3 on a malformed table.
+    acm_workbench::limits::LimitsDir::load(&limits_dir)?;
+    let mut app =
+        load_app(&dir.display().to_string(), &dir, &limits_dir).map_err(|e| anyhow!(e))?;
     show(
         &mut app,
         &Show {

@@ -113,6 +113,15 @@ pub struct CommonArgs {
     /// sensor-frame axis growing from START_S (repeatable).
     #[arg(long, value_parser = parse_slip, allow_hyphen_values = true)]
     pub slip: Vec<SensorSlip>,
+    /// Also write gyroscope columns <imu>_gx,<imu>_gy,<imu>_gz: each sensor's
+    /// angular rate in its own frame, rad/s, from the true motion through the
+    /// misalignment (drift and slippage included).
+    #[arg(long)]
+    pub gyro: bool,
+    /// White noise on the gyroscope readings, standard deviation per axis,
+    /// deg/s [default: 0].
+    #[arg(long, value_name = "DEG_S", requires = "gyro")]
+    pub gyro_noise: Option<f64>,
     /// Output trial file (`.csv` or `.csv.gz`); the truth goes beside it.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -198,6 +207,11 @@ impl CommonArgs {
         }
         if !self.slip.is_empty() {
             cfg.slips = self.slip.clone();
+        }
+        if self.gyro {
+            cfg.gyro = Some(simulate::GyroSim {
+                noise_deg_s: self.gyro_noise.unwrap_or(0.0),
+            });
         }
     }
 }
@@ -286,6 +300,12 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
             (a > 1e-9).then(|| format!("{imu} {a:.1}"))
         })
         .collect();
+    if let Some(g) = &cfg.gyro {
+        outln!(
+            "  gyroscopes: <imu>_gx,_gy,_gz in rad/s (sensor frame), white noise {} deg/s per axis",
+            g.noise_deg_s
+        )?;
+    }
     if misaligned.is_empty() {
         outln!("  misalignment: none")?;
     } else {
@@ -378,5 +398,55 @@ mod tests {
         let json = std::fs::read_to_string(dir.path().join("k.truth.json")).unwrap();
         let meta = acm_workbench::truth::TruthMeta::from_json(&json, "k.truth.json").unwrap();
         assert_eq!(meta.config.duration_s, 2.0);
+        assert_eq!(meta.config.gyro, None);
+        assert!(!json.contains("gyro"), "{json}");
+    }
+
+    #[test]
+    fn simulate_cli_writes_gyro_columns() {
+        use acm_workbench::model::Model;
+        use clap::Parser;
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("e.csv");
+        let args = [
+            "acmw",
+            "simulate",
+            "elbow",
+            "--duration",
+            "3",
+            "--gyro",
+            "--gyro-noise",
+            "0.5",
+            "-o",
+        ];
+        let mut argv: Vec<&str> = args.to_vec();
+        argv.push(out.to_str().unwrap());
+        let cli = crate::cli::Cli::try_parse_from(&argv).unwrap();
+        assert_eq!(crate::cli::run(cli), 0);
+        let text = std::fs::read_to_string(&out).unwrap();
+        assert!(
+            text.starts_with("time,l_upper_arm_qw,l_upper_arm_qx,l_upper_arm_qy,l_upper_arm_qz,l_upper_arm_gx,l_upper_arm_gy,l_upper_arm_gz,l_forearm_qw"),
+            "{}",
+            &text[..200]
+        );
+        let trial = acm_workbench::trial::read_trial(&out, &Model::infant13()).unwrap();
+        assert!(trial
+            .imus
+            .iter()
+            .all(|s| s.gyro.as_ref().map(Vec::len) == Some(150)));
+        let json = std::fs::read_to_string(dir.path().join("e.truth.json")).unwrap();
+        let meta = acm_workbench::truth::TruthMeta::from_json(&json, "e.truth.json").unwrap();
+        assert_eq!(meta.config.gyro.map(|g| g.noise_deg_s), Some(0.5));
+        // The noise needs --gyro.
+        let argv = [
+            "acmw",
+            "simulate",
+            "elbow",
+            "--gyro-noise",
+            "1",
+            "-o",
+            "x.csv",
+        ];
+        assert!(crate::cli::Cli::try_parse_from(argv).is_err());
     }
 }

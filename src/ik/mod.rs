@@ -183,10 +183,7 @@ pub fn solve_trial(
         .segments
         .iter()
         .zip(orientations)
-        .map(|(s, orientation)| ImuSeries {
-            name: s.imu.clone(),
-            orientation,
-        })
+        .map(|(s, orientation)| ImuSeries::new(s.imu.clone(), orientation))
         .collect();
     Ok(Some(IkSolution { run, segments }))
 }
@@ -215,7 +212,11 @@ pub fn correct_trial(
     let (ik, skipped) = match solved {
         Some(IkSolution { run, segments }) => {
             for s in segments {
-                corrected.imu_mut(&s.name).expect("present").orientation = s.orientation;
+                // Segment orientations, not sensor ones: the sensor-frame
+                // gyros no longer describe them and are dropped.
+                let imu = corrected.imu_mut(&s.name).expect("present");
+                imu.orientation = s.orientation;
+                imu.gyro = None;
             }
             let skipped = run.skipped.clone();
             (Some(Arc::new(run)), skipped)

@@ -182,10 +182,7 @@ pub fn simulate(model: &Model, config: &IkSimConfig) -> IkSim {
             .segments
             .iter()
             .zip(series)
-            .map(|(s, orientation)| ImuSeries {
-                name: s.imu.clone(),
-                orientation,
-            })
+            .map(|(s, orientation)| ImuSeries::new(s.imu.clone(), orientation))
             .collect(),
         warnings: vec![],
     };

@@ -21,6 +21,9 @@
 //! - Joint angles are Z-Y-X Euler angles of `G_R_prox^T * G_R_dist`, degrees;
 //!   segments chain as `G_R_dist = G_R_prox * R_joint(angles)` in model order.
 //! - Times are seconds from 0, sample `i` at `i / rate_hz`.
+//! - Gyroscopes (optional, [`SimConfig::gyro`]): the angular rate of each
+//!   sensor's orientation without the noise `N(t)`, `Rz(h(t)) G_R_segment(t) M S(t)`,
+//!   in the sensor frame, rad/s, plus white noise ([`gyro`]).
 
 use crate::limits::LimitTable;
 use crate::model::Model;
@@ -36,6 +39,7 @@ use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 
 mod elbow;
+pub mod gyro;
 mod motion;
 pub mod swing;
 #[cfg(test)]
@@ -62,8 +66,10 @@ pub const PRESETS: [&str; 5] = [
     "full_body_swing",
 ];
 pub use elbow::{
-    flexion_deg as elbow_flexion_deg, pronation_deg as elbow_pronation_deg, ELBOW_IMUS,
+    flexion_deg as elbow_flexion_deg, forearm_rate as elbow_forearm_rate,
+    pronation_deg as elbow_pronation_deg, ELBOW_IMUS,
 };
+pub use gyro::GyroSim;
 
 /// What to simulate, for how long, and which errors to put into the sensors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -87,6 +93,9 @@ pub struct SimConfig {
     /// Sensor slippages, at most one per IMU, never on the base.
     #[serde(default)]
     pub slips: Vec<SensorSlip>,
+    /// Gyroscope readings of every IMU beside its orientations (`None`: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gyro: Option<GyroSim>,
 }
 
 /// The simulated movement.
@@ -237,6 +246,7 @@ impl SimConfig {
             misalignment: Misalignment::None,
             drifts: vec![],
             slips: vec![],
+            gyro: None,
         }
     }
 
@@ -255,6 +265,7 @@ impl SimConfig {
             },
             drifts: vec![],
             slips: vec![],
+            gyro: None,
         }
     }
 
@@ -270,7 +281,15 @@ impl SimConfig {
             misalignment: Misalignment::None,
             drifts: vec![],
             slips: vec![],
+            gyro: None,
         }
+    }
+
+    /// The same configuration with gyroscopes whose white noise has the
+    /// standard deviation `noise_deg_s` per axis (deg/s).
+    pub fn with_gyro(mut self, noise_deg_s: f64) -> SimConfig {
+        self.gyro = Some(GyroSim { noise_deg_s });
+        self
     }
 
     /// Number of samples: `round(duration_s * rate_hz)`.
@@ -307,6 +326,14 @@ impl SimConfig {
                 "noise must be >= 0 degrees, found {}",
                 self.noise_deg
             ));
+        }
+        if let Some(g) = &self.gyro {
+            if !(g.noise_deg_s.is_finite() && g.noise_deg_s >= 0.0) {
+                return err(format!(
+                    "gyroscope noise must be >= 0 deg/s, found {}",
+                    g.noise_deg_s
+                ));
+            }
         }
         if let SimKind::Knee { angle_deg, .. } | SimKind::Elbow { angle_deg } = self.kind {
             if !angle_deg.is_finite() {
@@ -433,6 +460,7 @@ enum Stream {
     Misalignment = 2,
     Noise = 3,
     ElbowMisalignment = 4,
+    GyroNoise = 5,
 }
 
 fn rng(seed: u64, stream: Stream) -> ChaCha8Rng {
@@ -449,14 +477,12 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
     let time_s: Vec<f64> = (0..n).map(|i| i as f64 / config.rate_hz).collect();
 
     // Clean segment orientations, in model IMU order.
-    let segments: Vec<(String, Vec<Quat>)> = match config.kind {
-        SimKind::Knee { .. } => knee_segments(&time_s),
-        SimKind::FullBody => full_body_segments(&model, config.seed, &time_s),
-        SimKind::Elbow { .. } => elbow::segments(&time_s),
-        SimKind::Swing => swing::segments(&model, config.seed, &time_s),
-    };
+    let segments = segments_at(config, &model, &time_s);
 
     let misalignments = misalignments(config, &model, &segments);
+    let gyros = config
+        .gyro
+        .map(|g| sensor_gyros(config, &model, &time_s, &misalignments, g));
     let mut noise_rng = rng(config.seed, Stream::Noise);
     let sigma_rad = config.noise_deg.to_radians() / 3f64.sqrt();
     let noise = Normal::new(0.0, sigma_rad).map_err(|e| SimError(e.to_string()))?;
@@ -470,13 +496,7 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
             .iter()
             .zip(&time_s)
             .map(|(s, &t)| {
-                let mut q = s * m;
-                if let Some(d) = slip {
-                    q *= d.rotation_at(t);
-                }
-                if let Some(d) = drift {
-                    q = d.rotation_at(t) * q;
-                }
+                let mut q = clean_sensor(s, &m, drift, slip, t);
                 if config.noise_deg > 0.0 {
                     let v = Vector3::new(
                         noise.sample(&mut noise_rng),
@@ -488,10 +508,8 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
                 q
             })
             .collect();
-        measured.push(ImuSeries {
-            name: name.clone(),
-            orientation,
-        });
+        let gyro = gyros.as_ref().map(|g| g[name].clone());
+        measured.push(ImuSeries::new(name.clone(), orientation).with_gyro(gyro));
     }
 
     let label = kind_label(&config.kind);
@@ -507,7 +525,7 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
             time_s,
             imus: segments
                 .into_iter()
-                .map(|(name, orientation)| ImuSeries { name, orientation })
+                .map(|(name, orientation)| ImuSeries::new(name, orientation))
                 .collect(),
             warnings: vec![],
         },
@@ -522,6 +540,70 @@ pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
         },
     };
     Ok(Simulated { trial, truth })
+}
+
+/// Clean segment orientations of every simulated IMU at `time_s`, in model
+/// IMU order (the motion depends on the seed, not on the times asked for).
+fn segments_at(config: &SimConfig, model: &Model, time_s: &[f64]) -> Vec<(String, Vec<Quat>)> {
+    match config.kind {
+        SimKind::Knee { .. } => knee_segments(time_s),
+        SimKind::FullBody => full_body_segments(model, config.seed, time_s),
+        SimKind::Elbow { .. } => elbow::segments(time_s),
+        SimKind::Swing => swing::segments(model, config.seed, time_s),
+    }
+}
+
+/// The sensor's orientation without noise: `Rz(h(t)) G_R_segment M S(t)`.
+fn clean_sensor(
+    segment: &Quat,
+    m: &Quat,
+    drift: Option<&HeadingDrift>,
+    slip: Option<&SensorSlip>,
+    t: f64,
+) -> Quat {
+    let mut q = segment * m;
+    if let Some(d) = slip {
+        q *= d.rotation_at(t);
+    }
+    if let Some(d) = drift {
+        q = d.rotation_at(t) * q;
+    }
+    q
+}
+
+/// Gyroscope readings per IMU (rad/s, sensor frame): the body rate of the
+/// clean sensor orientation by a central difference over `t -+ gyro::STEP_S`,
+/// plus white noise from its own random stream (adding gyros changes nothing
+/// else of a seed's trial).
+fn sensor_gyros(
+    config: &SimConfig,
+    model: &Model,
+    time_s: &[f64],
+    misalignments: &BTreeMap<String, Quat>,
+    g: GyroSim,
+) -> BTreeMap<String, Vec<Vector3<f64>>> {
+    let shifted = |h: f64| -> Vec<f64> { time_s.iter().map(|t| t + h).collect() };
+    let (t_minus, t_plus) = (shifted(-gyro::STEP_S), shifted(gyro::STEP_S));
+    let span: Vec<f64> = t_plus.iter().zip(&t_minus).map(|(p, m)| p - m).collect();
+    let minus = segments_at(config, model, &t_minus);
+    let plus = segments_at(config, model, &t_plus);
+    let mut noise_rng = rng(config.seed, Stream::GyroNoise);
+    let mut out = BTreeMap::new();
+    for ((name, seg_m), (_, seg_p)) in minus.iter().zip(&plus) {
+        let m = misalignments[name];
+        let drift = config.drifts.iter().find(|d| &d.imu == name);
+        let slip = config.slips.iter().find(|d| &d.imu == name);
+        let sensor = |seg: &[Quat], ts: &[f64]| -> Vec<Quat> {
+            seg.iter()
+                .zip(ts)
+                .map(|(s, &t)| clean_sensor(s, &m, drift, slip, t))
+                .collect()
+        };
+        let mut rates = gyro::body_rates(&sensor(seg_m, &t_minus), &sensor(seg_p, &t_plus), &span);
+        gyro::add_noise(&mut rates, g.noise_deg_s, &mut noise_rng);
+        out.insert(name.clone(), rates);
+    }
+    out
 }
 
 fn kind_label(kind: &SimKind) -> String {

@@ -332,6 +332,11 @@ fn simulate_presets_and_validation() {
         "rate",
     );
     bad(short_full_body(1, 0.01), "fewer than 2 samples");
+    bad(short_full_body(1, 1.0).with_gyro(-1.0), "gyroscope noise");
+    bad(
+        short_full_body(1, 1.0).with_gyro(f64::NAN),
+        "gyroscope noise",
+    );
     bad(
         SimConfig {
             misalignment: Misalignment::Random {
@@ -360,4 +365,66 @@ fn simulate_fixed_misalignment_is_a_rotation_vector_in_degrees() {
     let want = rotation::quat_axis_angle_deg([0.0, 1.0, 0.0], 20.0);
     assert!(angle_between_deg(&m, &want) < 1e-12);
     assert!(rotation::angle_deg(&sim.truth.meta.misalignment("l_foot").unwrap()) < 1e-12);
+}
+
+/// Full body at 500 Hz with heading drift and slippage: every IMU's gyro is
+/// the rate at which its noise-free measured orientation turns, in its own
+/// frame (central difference of neighbouring samples, good to about 0.1 deg/s
+/// at this rate), and the drift's and slippage's own rates are in it.
+#[test]
+fn simulated_gyros_follow_the_measured_orientations_with_drift_and_slippage() {
+    let cfg = SimConfig {
+        noise_deg: 0.0,
+        rate_hz: 500.0,
+        drifts: vec![HeadingDrift {
+            imu: "l_calf".into(),
+            start_s: 1.0,
+            rate_deg_s: 5.0,
+        }],
+        slips: vec![SensorSlip {
+            imu: "l_calf".into(),
+            start_s: 2.0,
+            rate_deg_s: 8.0,
+            axis: [1.0, 2.0, 0.0],
+        }],
+        ..short_full_body(3, 6.0)
+    }
+    .with_gyro(0.0);
+    let sim = simulate(&cfg).unwrap();
+    let t = &sim.trial.time_s;
+    let mut worst = 0.0f64;
+    let mut peak = 0.0f64;
+    for imu in &sim.trial.imus {
+        let g = imu.gyro.as_ref().expect("every IMU has gyros");
+        let q = &imu.orientation;
+        for i in 1..q.len() - 1 {
+            if (t[i] - 1.0).abs() < 0.01 || (t[i] - 2.0).abs() < 0.01 {
+                continue; // the drift and the slippage start with a kink
+            }
+            let fd = (q[i - 1].inverse() * q[i + 1]).scaled_axis() / (t[i + 1] - t[i - 1]);
+            worst = worst.max((g[i] - fd).norm().to_degrees());
+            peak = peak.max(g[i].norm().to_degrees());
+        }
+    }
+    assert!(worst < 0.1, "gyro vs orientation: {worst} deg/s");
+    assert!(peak > 30.0, "peak rate {peak} deg/s");
+    // A heading drift adds its rate about the global vertical, seen in the
+    // sensor frame: w = w_plain + G_R_plain^-1 (h' Z).
+    let run = |drifts: Vec<HeadingDrift>| {
+        simulate(&SimConfig {
+            drifts,
+            slips: vec![],
+            ..cfg.clone()
+        })
+        .unwrap()
+        .trial
+    };
+    let (drifting, plain) = (run(cfg.drifts.clone()), run(vec![]));
+    let calf = |t: &Trial| t.imu("l_calf").unwrap().clone();
+    let (a, b) = (calf(&drifting), calf(&plain));
+    let (ga, gb) = (a.gyro.unwrap(), b.gyro.unwrap());
+    for i in (600..3000).step_by(50) {
+        let want = b.orientation[i].inverse() * Vector3::z() * 5f64.to_radians();
+        assert!((ga[i] - gb[i] - want).norm() < 1e-7, "{i}");
+    }
 }

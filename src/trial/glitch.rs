@@ -106,13 +106,13 @@ mod tests {
         Trial {
             name: "g".into(),
             time_s: times.to_vec(),
-            imus: vec![ImuSeries {
-                name: "a".into(),
-                orientation: angles
+            imus: vec![ImuSeries::new(
+                "a",
+                angles
                     .iter()
                     .map(|&a| quat_axis_angle_deg([0.0, 1.0, 0.0], a))
                     .collect(),
-            }],
+            )],
             warnings: vec![],
         }
     }

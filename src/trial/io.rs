@@ -11,6 +11,12 @@
 //!   `w,x,y,z` cell per IMU;
 //! * any of these gzip-compressed, when the name ends in `.gz`.
 //!
+//! Both CSV formats may also carry gyroscope readings: per IMU the three
+//! columns `<imu>_gx,<imu>_gy,<imu>_gz`, angular rate in rad/s in the sensor
+//! frame (all three or none; anywhere after `time`, written right after the
+//! IMU's orientation columns). `.sto` files have none; writing a trial with
+//! gyros to `.sto` leaves them out.
+//!
 //! `.csv` files are told apart by their header (`_qw` vs `_roll/_pitch/_yaw`).
 //! IMU names are mapped to canonical names with [`Model::canonical_imu`]; IMUs the
 //! model does not know are kept under the name found, with a warning.
@@ -22,6 +28,8 @@ use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Read, Write as _};
 use std::path::Path;
 
+#[cfg(test)]
+mod gyro_tests;
 pub(crate) mod parse;
 #[cfg(test)]
 mod tests;
@@ -337,6 +345,21 @@ pub fn write_trial(trial: &Trial, path: &Path, format: TrialFormat) -> Result<()
             "cannot write Xsens exports: expected quat-csv, euler-csv or sto",
         ));
     }
+    if let Some(bad) = trial.imus.iter().find(|s| {
+        s.gyro
+            .as_ref()
+            .is_some_and(|g| g.len() != trial.time_s.len())
+    }) {
+        return Err(TrialError::file(
+            origin,
+            format!(
+                "cannot write: IMU '{}' has {} gyroscope readings, expected one per time ({})",
+                bad.name,
+                bad.gyro.as_ref().map_or(0, Vec::len),
+                trial.time_s.len()
+            ),
+        ));
+    }
     if let Some(bad) = trial
         .imus
         .iter()
@@ -387,12 +410,15 @@ pub fn write_trial(trial: &Trial, path: &Path, format: TrialFormat) -> Result<()
 }
 
 /// The text of a trial in `format` (uncompressed). Numbers use Rust's shortest
-/// round-trip formatting; quaternions are written with `w >= 0`.
+/// round-trip formatting; quaternions are written with `w >= 0`. In the CSV
+/// formats an IMU's gyroscope readings, when it has them, follow its
+/// orientation columns as `<imu>_gx,<imu>_gy,<imu>_gz` (rad/s, sensor frame);
+/// `.sto` has no place for them.
 pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
     let n = trial
         .imus
         .iter()
-        .map(|s| s.orientation.len())
+        .flat_map(|s| std::iter::once(s.orientation.len()).chain(s.gyro.as_ref().map(Vec::len)))
         .fold(trial.time_s.len(), usize::min);
     let per_row = 12 + trial.imus.len() * 4 * 22;
     let mut out = String::with_capacity(256 + n * per_row);
@@ -409,6 +435,11 @@ pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
                 for suf in suffixes {
                     let _ = write!(out, ",{}_{suf}", s.name);
                 }
+                if s.gyro.is_some() {
+                    for suf in parse::GYRO_SUFFIXES {
+                        let _ = write!(out, ",{}_{suf}", s.name);
+                    }
+                }
             }
             out.push('\n');
             for i in 0..n {
@@ -421,6 +452,10 @@ pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
                     } else {
                         let [r, p, y] = euler_zyx_deg(q);
                         let _ = write!(out, ",{r},{p},{y}");
+                    }
+                    if let Some(g) = &s.gyro {
+                        let w = &g[i];
+                        let _ = write!(out, ",{},{},{}", w.x, w.y, w.z);
                     }
                 }
                 out.push('\n');

@@ -1,11 +1,13 @@
 //! Recorded trials: IMU orientations over time, and their file formats.
 //!
 //! A [`Trial`] holds, per IMU, the orientation `G_R_imu` (sensor frame to global
-//! frame G) at each sample time (seconds). Readers and writers for the supported
+//! frame G) at each sample time (seconds), and optionally the IMU's gyroscope
+//! readings (angular rate, rad/s, sensor frame). Readers and writers for the supported
 //! formats live in the submodules; [`read_trial`] and [`write_trial`] pick by
 //! file name.
 
 use crate::rotation::Quat;
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 mod error;
@@ -19,13 +21,46 @@ pub mod xsens_trial;
 pub use error::TrialError;
 pub use io::*;
 
-/// Orientations of one IMU over the trial's samples.
+/// Orientations (and optionally gyroscope readings) of one IMU over the
+/// trial's samples.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImuSeries {
     /// Canonical IMU name (after the model's aliases).
     pub name: String,
     /// `G_R_imu` per sample, unit quaternions.
     pub orientation: Vec<Quat>,
+    /// Gyroscope readings when the trial has them: the IMU's angular rate in
+    /// rad/s, expressed in its own sensor frame (the body rate `w` of
+    /// `d/dt G_R_imu = G_R_imu [w]x`), one per sample, same length as
+    /// `orientation`. `None` when the trial has no gyroscope columns.
+    pub gyro: Option<Vec<Vector3<f64>>>,
+}
+
+impl ImuSeries {
+    /// A series of orientations without gyroscope readings.
+    pub fn new(name: impl Into<String>, orientation: Vec<Quat>) -> ImuSeries {
+        ImuSeries {
+            name: name.into(),
+            orientation,
+            gyro: None,
+        }
+    }
+
+    /// The same series with gyroscope readings (rad/s, sensor frame).
+    pub fn with_gyro(mut self, gyro: Option<Vec<Vector3<f64>>>) -> ImuSeries {
+        self.gyro = gyro;
+        self
+    }
+
+    /// Re-expresses the gyroscope readings in the sensor frame turned by `r`
+    /// (`G_R_imu' = G_R_imu * r`, `r` constant): `w' = r^-1 w`. The
+    /// orientations are left to the caller. Nothing happens without gyros.
+    pub fn turn_gyro(&mut self, r: &Quat) {
+        let inv = r.inverse();
+        if let Some(g) = &mut self.gyro {
+            g.iter_mut().for_each(|w| *w = inv * *w);
+        }
+    }
 }
 
 /// A recorded (or corrected) trial.
@@ -87,6 +122,36 @@ impl Trial {
     /// Mutable access to the series of the IMU with this canonical name.
     pub fn imu_mut(&mut self, name: &str) -> Option<&mut ImuSeries> {
         self.imus.iter_mut().find(|s| s.name == name)
+    }
+
+    /// The samples at `idx` (in that order, indices into this trial), every
+    /// IMU's orientations and gyroscope readings picked alike: a thinned,
+    /// cut or resampled-by-selection trial keeps its gyros aligned.
+    ///
+    /// # Panics
+    /// When an index is out of range (callers pick from `0..len()`).
+    pub fn select(&self, idx: &[usize], name: &str) -> Trial {
+        Trial {
+            name: name.to_string(),
+            time_s: idx.iter().map(|&i| self.time_s[i]).collect(),
+            imus: self
+                .imus
+                .iter()
+                .map(|s| {
+                    ImuSeries::new(
+                        s.name.clone(),
+                        idx.iter().map(|&i| s.orientation[i]).collect(),
+                    )
+                    .with_gyro(s.gyro.as_ref().map(|g| idx.iter().map(|&i| g[i]).collect()))
+                })
+                .collect(),
+            warnings: self.warnings.clone(),
+        }
+    }
+
+    /// True when any IMU carries gyroscope readings.
+    pub fn has_gyros(&self) -> bool {
+        self.imus.iter().any(|s| s.gyro.is_some())
     }
 
     /// Median interval between samples, seconds (0 for fewer than two samples).
@@ -169,5 +234,25 @@ mod tests {
         };
         assert!((t.duration_s() - 60.0).abs() < 1e-9);
         assert!((t.rate_hz() - 50.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn turned_gyros_are_the_rates_of_the_turned_orientations() {
+        use crate::rotation::quat_axis_angle_deg;
+        // A constant body rate w: G_R(t) = G_R0 exp(w t); turned by r the
+        // orientation G_R r turns at r^-1 w in the new frame.
+        let w = Vector3::new(0.4, -1.1, 0.7);
+        let g0 = quat_axis_angle_deg([0.2, 0.9, -0.3], 50.0);
+        let at = |t: f64| g0 * Quat::from_scaled_axis(w * t);
+        let mut s = ImuSeries::new("a", vec![at(0.0)]).with_gyro(Some(vec![w]));
+        let r = quat_axis_angle_deg([1.0, 0.5, 0.0], 35.0);
+        s.turn_gyro(&r);
+        let h = 1e-6;
+        let fd = ((at(-h) * r).inverse() * (at(h) * r)).scaled_axis() / (2.0 * h);
+        assert!((s.gyro.as_ref().unwrap()[0] - fd).norm() < 1e-8);
+        assert!((w - fd).norm() > 0.3, "the turn matters");
+        let mut none = ImuSeries::new("b", vec![at(0.0)]);
+        none.turn_gyro(&r);
+        assert!(none.gyro.is_none());
     }
 }

@@ -16,13 +16,17 @@
 //!   (MT Manager lists them column by column: `Mat[1][1] Mat[2][1] Mat[3][1] Mat[1][2] ...`);
 //! * `Roll Pitch Yaw` (or `Euler_X Euler_Y Euler_Z`), degrees, `Rz(yaw) Ry(pitch) Rx(roll)`.
 //!
+//! Optional `Gyr_X Gyr_Y Gyr_Z` columns (MT Manager's calibrated rate of turn,
+//! rad/s in the sensor frame) are read as the sensor's gyroscope readings; all
+//! three or none.
+//!
 //! `PacketCounter` is a 16-bit counter that wraps from 65535 to 0; it is unwrapped
 //! here and is what sensors are aligned on ([`super::xsens_trial`]).
 
 use super::io::parse::{show, LineIter, NORM_NOTE, NORM_TOLERANCE};
 use super::TrialError;
 use crate::rotation::{quat_from_euler_zyx_deg, Quat};
-use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion};
+use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
 
 /// The packet counter's modulus (it is 16 bits wide).
 pub const COUNTER_MODULUS: u64 = 1 << 16;
@@ -57,6 +61,9 @@ pub struct XsensExport {
     pub orientation: Vec<Quat>,
     /// Which columns the orientation came from.
     pub columns: OrientationColumns,
+    /// Rate of turn per sample from `Gyr_X Gyr_Y Gyr_Z`, rad/s, sensor frame;
+    /// `None` when the export has no such columns.
+    pub gyro: Option<Vec<Vector3<f64>>>,
     /// Quaternions renormalised by more than [`NORM_NOTE`] (count).
     pub renormalised: usize,
 }
@@ -67,6 +74,41 @@ struct Columns {
     kind: OrientationColumns,
     /// Quaternion: w x y z; matrix: row-major R[0][0], R[0][1], ...; Euler: roll pitch yaw.
     fields: Vec<usize>,
+    /// `Gyr_X Gyr_Y Gyr_Z`, when present.
+    gyro: Option<[usize; 3]>,
+}
+
+/// The gyroscope columns: all of `Gyr_X Gyr_Y Gyr_Z`, none, or an error at
+/// the first one present when some are missing.
+fn gyro_columns(
+    header: &[&str],
+    origin: &str,
+    line: u64,
+) -> Result<Option<[usize; 3]>, TrialError> {
+    const NAMES: [&str; 3] = ["Gyr_X", "Gyr_Y", "Gyr_Z"];
+    let found = NAMES.map(|n| find(header, n));
+    match found {
+        [Some(x), Some(y), Some(z)] => Ok(Some([x, y, z])),
+        [None, None, None] => Ok(None),
+        _ => {
+            let first = found.iter().flatten().min().copied().unwrap_or(0);
+            let missing: Vec<&str> = NAMES
+                .iter()
+                .zip(found)
+                .filter(|(_, f)| f.is_none())
+                .map(|(n, _)| *n)
+                .collect();
+            Err(TrialError::at(
+                origin,
+                line,
+                first + 1,
+                format!(
+                    "incomplete gyroscope columns: missing {}; expected all of Gyr_X, Gyr_Y, Gyr_Z (rad/s, sensor frame) or none",
+                    missing.join(" and ")
+                ),
+            ))
+        }
+    }
 }
 
 fn find(header: &[&str], name: &str) -> Option<usize> {
@@ -86,12 +128,14 @@ fn columns(header: &[&str], origin: &str, line: u64) -> Result<Columns, TrialErr
             "expected a 'PacketCounter' column (sensors are aligned on it); export it from MT Manager",
         )
     })?;
+    let gyro = gyro_columns(header, origin, line)?;
     let quat: Vec<String> = (0..4).map(|k| format!("Quat_q{k}")).collect();
     if let Some(fields) = find_all(header, &quat) {
         return Ok(Columns {
             counter,
             kind: OrientationColumns::Quaternion,
             fields,
+            gyro,
         });
     }
     let mat: Vec<String> = (1..=3)
@@ -102,6 +146,7 @@ fn columns(header: &[&str], origin: &str, line: u64) -> Result<Columns, TrialErr
             counter,
             kind: OrientationColumns::Matrix,
             fields,
+            gyro,
         });
     }
     for names in [["Roll", "Pitch", "Yaw"], ["Euler_X", "Euler_Y", "Euler_Z"]] {
@@ -111,6 +156,7 @@ fn columns(header: &[&str], origin: &str, line: u64) -> Result<Columns, TrialErr
                 counter,
                 kind: OrientationColumns::Euler,
                 fields,
+                gyro,
             });
         }
     }
@@ -210,6 +256,7 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
         lines: Vec::new(),
         orientation: Vec::new(),
         columns: cols.kind,
+        gyro: cols.gyro.map(|_| Vec::new()),
         renormalised: 0,
     };
     let mut last_raw: Option<(u64, u64)> = None;
@@ -244,6 +291,10 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
         }
         last_raw = Some((raw, line));
         let q = orientation(&cells, &cols, &header, origin, line, &mut out.renormalised)?;
+        if let (Some(fields), Some(g)) = (cols.gyro, &mut out.gyro) {
+            let [x, y, z] = fields.map(|k| number(&cells, k, origin, line, header[k]));
+            g.push(Vector3::new(x?, y?, z?));
+        }
         out.counters.push(raw + wraps * COUNTER_MODULUS);
         out.lines.push(line);
         out.orientation.push(q);

@@ -9,7 +9,8 @@
 //! Sensors are aligned on the unwrapped packet counter: only packets every
 //! sensor recorded are kept (as OpenSense does), time is
 //! `(counter - first kept counter) / rate` in seconds, and packets a sensor
-//! lacks become gaps in the time vector, each one reported.
+//! lacks become gaps in the time vector, each one reported. Gyroscope columns
+//! (`Gyr_X Gyr_Y Gyr_Z`, rad/s, sensor frame) are aligned the same way.
 
 use super::mapping::{looks_like_mapping, parse_mapping, sensor_to_opensim, Mapping};
 use super::xsens::{parse_export, XsensExport, COUNTER_MODULUS};
@@ -431,10 +432,14 @@ pub(crate) fn assemble(
                 rotation.map_or(q, |r| r * q)
             })
             .collect();
-        imus.push(ImuSeries {
-            name: canonical,
-            orientation,
-        });
+        // Gyros are picked by the same packet indices as the orientations, so
+        // they stay aligned; the mapping's rotation turns the global frame only
+        // (on the left), which leaves sensor-frame rates as they are.
+        let gyro = e
+            .gyro
+            .as_ref()
+            .map(|g| kept.iter().map(|(_, idx)| g[idx[k]]).collect());
+        imus.push(ImuSeries::new(canonical, orientation).with_gyro(gyro));
     }
     Ok(Trial {
         name: name.to_string(),

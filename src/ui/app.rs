@@ -8,7 +8,9 @@ use crate::metrics::JointFigures;
 use crate::model::Model;
 use crate::report::TrialReport;
 use crate::trial::{Trial, TrialFormat};
-use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind, MouseEvent, MouseEventKind};
+use ratatui::crossterm::event::{
+    KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseEvent, MouseEventKind,
+};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -228,8 +230,61 @@ impl View {
 #[derive(Debug, Clone, PartialEq)]
 pub struct CellEdit {
     pub text: String,
+    /// Insertion point, in characters from the start of `text`.
+    pub cursor: usize,
     /// Why the text cannot be committed, if it cannot.
     pub error: Option<String>,
+}
+
+impl CellEdit {
+    /// Starts editing `text` with the cursor at its end.
+    pub fn new(text: String) -> Self {
+        let cursor = text.chars().count();
+        CellEdit {
+            text,
+            cursor,
+            error: None,
+        }
+    }
+
+    /// Byte offset of the character at `char_index` (the end if past it).
+    fn byte_at(&self, char_index: usize) -> usize {
+        self.text
+            .char_indices()
+            .nth(char_index)
+            .map_or(self.text.len(), |(b, _)| b)
+    }
+
+    /// Applies one editing key; returns whether the key was an editing key.
+    /// Left/Right/Home/End move the cursor, Backspace and Delete remove the
+    /// character before or under it, Ctrl-U clears the cell, characters insert.
+    pub fn key(&mut self, k: KeyEvent) -> bool {
+        let n = self.text.chars().count();
+        match k.code {
+            KeyCode::Left => self.cursor = self.cursor.saturating_sub(1),
+            KeyCode::Right => self.cursor = (self.cursor + 1).min(n),
+            KeyCode::Home => self.cursor = 0,
+            KeyCode::End => self.cursor = n,
+            KeyCode::Backspace if self.cursor > 0 => {
+                self.cursor -= 1;
+                self.text.remove(self.byte_at(self.cursor));
+            }
+            KeyCode::Delete if self.cursor < n => {
+                self.text.remove(self.byte_at(self.cursor));
+            }
+            KeyCode::Char('u') if k.modifiers.contains(KeyModifiers::CONTROL) => {
+                self.text.clear();
+                self.cursor = 0;
+            }
+            KeyCode::Char(c) if !k.modifiers.contains(KeyModifiers::CONTROL) => {
+                self.text.insert(self.byte_at(self.cursor), c);
+                self.cursor += 1;
+            }
+            KeyCode::Backspace | KeyCode::Delete => {}
+            _ => return false,
+        }
+        true
+    }
 }
 
 /// The limits editor: the table and settings, as saved and as edited.
@@ -529,11 +584,8 @@ pub enum Msg {
     Tick,
     /// The calibration recordings of the folder, read and calibrated (protocol label).
     Calibrations(Vec<super::calibration::CalibEntry>, String),
-    /// The histograms of the histogram screen's trials over a span.
-    Histograms(
-        crate::analysis::TimeSpan,
-        Vec<crate::analysis::histogram::JointHistogram>,
-    ),
+    /// The histograms and centroids of the histogram screen's trials over a span.
+    Histograms(Box<super::histogram::Computed>),
     /// A suggested limit table or a centroid table was written (its path), or why not.
     TableWritten(Result<String, String>),
     /// A pose-calibrated version of a trial, or why there is none.
@@ -874,10 +926,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             super::calibration::loaded(app, entries, protocol);
             vec![]
         }
-        Msg::Histograms(span, hists) => {
-            super::histogram::received(app, span, hists);
-            vec![]
-        }
+        Msg::Histograms(c) => super::histogram::received(app, *c),
         Msg::TableWritten(result) => {
             super::histogram::written(app, result);
             vec![]
@@ -1021,11 +1070,11 @@ fn edit_key(app: &mut App, k: KeyEvent) -> Vec<Effect> {
                 }
             }
         }
-        KeyCode::Backspace => {
-            edit.text.pop();
+        _ => {
+            if !edit.key(k) {
+                return vec![];
+            }
         }
-        KeyCode::Char(c) => edit.text.push(c),
-        _ => return vec![],
     }
     let text = edit.text.clone();
     let err = l.apply(&text).err();
@@ -1314,7 +1363,7 @@ fn limits_action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::Right => l.col = (l.col + 1).min(LAST_COL),
         Action::Enter => {
             let text = l.cell_text(l.row, l.col);
-            l.edit = Some(CellEdit { text, error: None });
+            l.edit = Some(CellEdit::new(text));
         }
         Action::Save => {
             let (table, settings) = (l.table.clone(), l.settings.clone());

@@ -3,7 +3,9 @@
 //! first 30 s unless moved), with the current limits, the mean and the
 //! interval holding 90% of the samples (thesis 3.1.2); Enter suggests a limit
 //! table from those intervals and shows its diff before saving it beside the
-//! current table; `w` saves the centroid table (thesis 3.3).
+//! current table; `w` saves the centroid table (thesis 3.3). Everything is
+//! computed in a background job; a suggestion or centroid save asked for while
+//! it runs is carried out when it arrives.
 //!
 //! The trials are the open one (from the trial screen) or every loaded trial
 //! the trials screen shows (filter with `/` first to choose).
@@ -12,7 +14,7 @@ use super::app::{App, Effect, Loaded, Msg, Screen};
 use super::keymap::Action;
 use super::render::{centred, fit, sel};
 use super::theme::Theme;
-use crate::analysis::centroid::centroids;
+use crate::analysis::centroid::{centroids, CentroidTable};
 use crate::analysis::histogram::{histograms, AxisHistogram, JointHistogram, DEFAULT_BIN_DEG};
 use crate::analysis::suggest::{same_file, suggest_limits, SuggestOptions, Suggestion, WriteError};
 use crate::analysis::{pool_by_joint, pool_by_table_row, TimeSpan, TrialRef};
@@ -42,6 +44,11 @@ pub struct HistogramState {
     /// Still computing `span` in the background: `hists` are of an earlier
     /// span (or empty) until it arrives.
     pub computing: bool,
+    /// The span's samples pooled per limit-table row, for the suggestion and
+    /// the centroids (of the span and table last computed).
+    pub rows: Option<Arc<RowAnalysis>>,
+    /// Enter or `w` pressed while computing: done when the job answers.
+    pub pending: Option<Action>,
     /// Selected joint (index into `hists`).
     pub joint: usize,
     /// A suggested table waiting for y (save) or n (cancel), and the diff's scroll.
@@ -71,6 +78,8 @@ pub fn open(app: &mut App) -> Vec<Effect> {
         span: TimeSpan::FIRST_30_S,
         hists: vec![],
         computing: true,
+        rows: None,
+        pending: None,
         joint: 0,
         suggestion: None,
         scroll: 0,
@@ -91,7 +100,27 @@ fn request(app: &App, files: &[String], span: TimeSpan) -> Effect {
     }
 }
 
-/// Per-joint histograms of loaded trials over `span` (in a worker thread).
+/// What the histogram job computes over one span.
+#[derive(Debug, Clone)]
+pub struct Computed {
+    pub span: TimeSpan,
+    /// One histogram per joint, in model order.
+    pub joints: Vec<JointHistogram>,
+    pub rows: Arc<RowAnalysis>,
+}
+
+/// The span's samples pooled per row of `table` (joints sharing a row pool
+/// together): the histograms a suggestion is made from, and the centroids.
+#[derive(Debug, Clone)]
+pub struct RowAnalysis {
+    /// The table the rows are of (a suggestion needs the same one).
+    pub table: LimitTable,
+    pub hists: Vec<JointHistogram>,
+    pub centroids: CentroidTable,
+}
+
+/// Histograms (per joint and per table row) and centroids of loaded trials
+/// over `span` (in a worker thread).
 pub fn compute_job(trials: &[Arc<Loaded>], span: TimeSpan, table: &LimitTable) -> Msg {
     let refs: Vec<TrialRef> = trials
         .iter()
@@ -100,33 +129,65 @@ pub fn compute_job(trials: &[Arc<Loaded>], span: TimeSpan, table: &LimitTable) -
             model: &l.model,
         })
         .collect();
-    let hists = match refs.first() {
-        None => vec![],
-        Some(r) => histograms(&pool_by_joint(&refs, span), table, r.model, DEFAULT_BIN_DEG),
+    let (joints, hists, centroid_table) = match refs.first() {
+        None => (vec![], vec![], centroids(&[], span)),
+        Some(r) => {
+            let by_row = pool_by_table_row(&refs, span, table);
+            (
+                histograms(&pool_by_joint(&refs, span), table, r.model, DEFAULT_BIN_DEG),
+                histograms(&by_row, table, r.model, DEFAULT_BIN_DEG),
+                centroids(&by_row, span),
+            )
+        }
     };
-    Msg::Histograms(span, hists)
+    Msg::Histograms(Box::new(Computed {
+        span,
+        joints,
+        rows: Arc::new(RowAnalysis {
+            table: table.clone(),
+            hists,
+            centroids: centroid_table,
+        }),
+    }))
 }
 
-/// Takes the histograms of the span the screen last asked for; drops those of
-/// spans it has moved past.
-pub fn received(app: &mut App, span: TimeSpan, hists: Vec<JointHistogram>) {
-    if let Some(st) = app.histogram.as_mut().filter(|st| st.span == span) {
-        st.hists = hists;
-        st.computing = false;
-        st.joint = st.joint.min(st.hists.len().saturating_sub(1));
+/// Takes the results of the span the screen last asked for (dropping those of
+/// spans it has moved past), then does a suggestion or save asked for meanwhile.
+pub fn received(app: &mut App, c: Computed) -> Vec<Effect> {
+    let Some(st) = app.histogram.as_mut().filter(|st| st.span == c.span) else {
+        return vec![];
+    };
+    st.hists = c.joints;
+    st.rows = Some(c.rows);
+    st.computing = false;
+    st.joint = st.joint.min(st.hists.len().saturating_sub(1));
+    match st.pending.take() {
+        Some(Action::Enter) => suggest(app),
+        Some(Action::Save) => save_centroids(app),
+        _ => vec![],
     }
 }
 
-/// The trials of `files` that are loaded, with their models.
-fn refs<'a>(app: &'a App, files: &[String]) -> Vec<TrialRef<'a>> {
-    files
-        .iter()
-        .filter_map(|f| app.entry(f)?.loaded())
-        .map(|l| TrialRef {
-            trial: &l.trial,
-            model: &l.model,
-        })
-        .collect()
+/// The row analysis of the current span against the current table; else
+/// `then` is remembered for when it arrives (asking for it if the table changed).
+fn ready_rows(app: &mut App, then: Action) -> Result<Arc<RowAnalysis>, Vec<Effect>> {
+    let table = &app.limits.table;
+    let Some(st) = app.histogram.as_mut() else {
+        return Err(vec![]);
+    };
+    match &st.rows {
+        Some(r) if !st.computing && r.table == *table => Ok(r.clone()),
+        _ => {
+            st.pending = Some(then);
+            app.message = Some(("computing; done when the histograms arrive".into(), false));
+            if st.computing {
+                return Err(vec![]);
+            }
+            st.computing = true;
+            let (files, span) = (st.files.clone(), st.span);
+            Err(vec![request(app, &files, span)])
+        }
+    }
 }
 
 /// The suggested table's file: `<table stem>.suggested.csv` beside the table.
@@ -192,18 +253,15 @@ pub fn action(app: &mut App, a: Action) -> Vec<Effect> {
 
 /// The suggestion from the chosen trials' intervals, pooled per table row.
 fn suggest(app: &mut App) -> Vec<Effect> {
-    let Some(st) = app.histogram.as_ref() else {
+    let rows = match ready_rows(app, Action::Enter) {
+        Ok(r) => r,
+        Err(fx) => return fx,
+    };
+    let Some(st) = app.histogram.as_mut() else {
         return vec![];
     };
-    let refs = refs(app, &st.files);
-    let Some(model) = refs.first().map(|r| r.model) else {
-        return vec![];
-    };
-    let table = &app.limits.table;
-    let pooled = pool_by_table_row(&refs, st.span, table);
-    let hists = histograms(&pooled, table, model, DEFAULT_BIN_DEG);
-    let s = suggest_limits(table, &hists, st.span, SuggestOptions::default());
-    if let Some(st) = app.histogram.as_mut() {
+    let s = suggest_limits(&rows.table, &rows.hists, st.span, SuggestOptions::default());
+    {
         st.suggestion = Some(Arc::new(s));
         st.scroll = 0;
     }
@@ -235,16 +293,14 @@ fn confirm(app: &mut App, s: &Suggestion, a: Action) -> Vec<Effect> {
 }
 
 fn save_centroids(app: &mut App) -> Vec<Effect> {
-    let Some(st) = app.histogram.as_ref() else {
-        return vec![];
+    let rows = match ready_rows(app, Action::Save) {
+        Ok(r) => r,
+        Err(fx) => return fx,
     };
-    let refs = refs(app, &st.files);
-    let pooled = pool_by_table_row(&refs, st.span, &app.limits.table);
-    let table = centroids(&pooled, st.span);
     vec![Effect::WriteTable {
         path: centroids_path(app),
         original: None,
-        csv: table.to_csv(),
+        csv: rows.centroids.to_csv(),
     }]
 }
 
@@ -559,12 +615,27 @@ mod tests {
         let Effect::Histograms { trials, table, .. } = &fx[0] else {
             unreachable!()
         };
-        let Msg::Histograms(_, stale) = compute_job(trials, TimeSpan::WHOLE, table) else {
+        let Msg::Histograms(stale) = compute_job(trials, TimeSpan::WHOLE, table) else {
             unreachable!()
         };
-        received(&mut app, TimeSpan::WHOLE, stale);
+        assert!(received(&mut app, *stale).is_empty());
         assert!(app.histogram.as_ref().unwrap().computing);
+        // Enter while computing waits for the job instead of blocking.
+        let waits = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Enter)));
+        assert!(waits.is_empty(), "{waits:?}");
+        assert_eq!(app.histogram.as_ref().unwrap().pending, Some(Action::Enter));
         SyncRunner::run(&mut app, fx);
+        let st = app.histogram.as_ref().unwrap();
+        assert!(!st.computing && st.pending.is_none());
+        assert!(st.suggestion.is_some(), "the waiting suggestion is made");
+        key(&mut app, KeyCode::Char('n'));
+        // A limits edit since the job: `w` asks for the rows anew, then saves.
+        app.limits.table.rows[0].upper_deg += 1.0;
+        let fx = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('w'))));
+        assert!(matches!(fx[..], [Effect::Histograms { .. }]), "{fx:?}");
+        std::fs::remove_file(root.join("joint_limits/centroids.csv")).unwrap();
+        SyncRunner::run(&mut app, fx);
+        assert!(root.join("joint_limits/centroids.csv").exists());
         let st = app.histogram.as_ref().unwrap();
         assert!(!st.computing);
         // Both trials pooled: the knee trial adds its l_knee samples.

@@ -5,7 +5,7 @@ use super::render::fit;
 use super::theme::Theme;
 use crate::limits::HEADER;
 use ratatui::layout::{Constraint, Layout, Rect};
-use ratatui::style::Style;
+use ratatui::style::{Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 use ratatui::Frame;
@@ -64,10 +64,10 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         if let Some(s) = r.checked_sub(l.table.rows.len()) {
             let name = SETTING_NAMES[s];
             spans.push(Span::styled(fit(name, w[0] + w[1] + w[2]), theme.header));
-            spans.push(cell_span(app, theme, r, 3, w[3] + w[4]));
+            spans.extend(cell_spans(app, theme, r, 3, w[3] + w[4]));
         } else {
             for (c, &cw) in w.iter().enumerate() {
-                spans.push(cell_span(app, theme, r, c, cw));
+                spans.extend(cell_spans(app, theme, r, c, cw));
             }
         }
         let mut line = Line::from(spans);
@@ -99,7 +99,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     );
 }
 
-fn cell_span(app: &App, theme: &Theme, row: usize, col: usize, w: usize) -> Span<'static> {
+fn cell_spans(app: &App, theme: &Theme, row: usize, col: usize, w: usize) -> Vec<Span<'static>> {
     let l = &app.limits;
     let on_setting = row >= l.table.rows.len();
     let selected = row == l.row && (on_setting || col == l.col);
@@ -110,8 +110,7 @@ fn cell_span(app: &App, theme: &Theme, row: usize, col: usize, w: usize) -> Span
             } else {
                 (">", theme.edited)
             };
-            let text = format!("{mark}{}_", e.text);
-            return Span::styled(format!("{:>w$}", fit_right(&text, w)), style);
+            return edit_spans(&e.text, e.cursor, mark, style, w);
         }
     }
     let text = l.cell_text(row, col);
@@ -130,7 +129,36 @@ fn cell_span(app: &App, theme: &Theme, row: usize, col: usize, w: usize) -> Span
     if selected {
         style = style.patch(theme.selected);
     }
-    Span::styled(body, style)
+    vec![Span::styled(body, style)]
+}
+
+/// A cell being edited, right-aligned in `w` columns (one kept as a gap, as
+/// [`fit_right`] does): the mark (`>` valid, `x` invalid), the text, and the
+/// cursor: `_` past the end, else the character under it shown reversed. Text
+/// too long for the cell loses its left end, never the cursor.
+fn edit_spans(text: &str, cursor: usize, mark: &str, style: Style, w: usize) -> Vec<Span<'static>> {
+    let mut chars: Vec<char> = mark.chars().chain(text.chars()).collect();
+    let at = cursor + mark.chars().count();
+    let past_end = at >= chars.len();
+    if past_end {
+        chars.push('_');
+    }
+    let room = w.saturating_sub(1).max(1);
+    let skip = chars.len().saturating_sub(room).min(at);
+    let shown = &chars[skip..chars.len().min(skip + room)];
+    let at = at - skip;
+    let pad = " ".repeat(w.saturating_sub(shown.len()));
+    let before: String = shown[..at].iter().collect();
+    let cursor_style = if past_end {
+        style
+    } else {
+        style.add_modifier(Modifier::REVERSED)
+    };
+    vec![
+        Span::styled(format!("{pad}{before}"), style),
+        Span::styled(shown[at].to_string(), cursor_style),
+        Span::styled(shown[at + 1..].iter().collect::<String>(), style),
+    ]
 }
 
 fn fit_right(s: &str, w: usize) -> String {
@@ -139,5 +167,65 @@ fn fit_right(s: &str, w: usize) -> String {
         s.to_string()
     } else {
         s.chars().skip(n + 1 - w.max(1)).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ui::app::CellEdit;
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+    fn press(e: &mut CellEdit, codes: &[KeyCode]) {
+        for &c in codes {
+            assert!(e.key(KeyEvent::from(c)), "{c:?} is an editing key");
+        }
+    }
+
+    fn shown(spans: &[Span]) -> (String, String) {
+        let all: String = spans.iter().map(|s| s.content.as_ref()).collect();
+        (all, spans[1].content.to_string())
+    }
+
+    #[test]
+    fn cell_editor_edits_anywhere_in_the_cell() {
+        let mut e = CellEdit::new("150".into());
+        assert_eq!(e.cursor, 3);
+        // 150 -> 125: to the 5, delete it and the 0, type 25 before the end.
+        press(&mut e, &[KeyCode::Left, KeyCode::Left, KeyCode::Delete]);
+        assert_eq!((e.text.as_str(), e.cursor), ("10", 1));
+        press(&mut e, &[KeyCode::Backspace, KeyCode::Char('2')]);
+        assert_eq!((e.text.as_str(), e.cursor), ("20", 1));
+        press(&mut e, &[KeyCode::Home, KeyCode::Char('-'), KeyCode::End]);
+        assert_eq!((e.text.as_str(), e.cursor), ("-20", 3));
+        // At the ends, Backspace and Delete do nothing and stay editing keys.
+        press(
+            &mut e,
+            &[KeyCode::Delete, KeyCode::Home, KeyCode::Backspace],
+        );
+        assert_eq!((e.text.as_str(), e.cursor), ("-20", 0));
+        let ctrl_u = KeyEvent::new(KeyCode::Char('u'), KeyModifiers::CONTROL);
+        assert!(e.key(ctrl_u));
+        assert_eq!((e.text.as_str(), e.cursor), ("", 0));
+        // Keys that are not editing keys are left to the caller.
+        assert!(!e.key(KeyEvent::from(KeyCode::Up)));
+    }
+
+    #[test]
+    fn edited_cell_shows_its_cursor() {
+        let st = Style::default();
+        // At the end: an underscore, as before the cursor could move.
+        let (all, under) = shown(&edit_spans("150", 3, ">", st, 8));
+        assert_eq!((all.as_str(), under.as_str()), ("   >150_", "_"));
+        // In the middle: the character under the cursor, reversed.
+        let spans = edit_spans("150", 1, ">", st, 8);
+        let (all, under) = shown(&spans);
+        assert_eq!((all.as_str(), under.as_str()), ("    >150", "5"));
+        assert!(spans[1].style.add_modifier.contains(Modifier::REVERSED));
+        // Too long for the cell: the left end goes, the cursor stays in view.
+        let (all, under) = shown(&edit_spans("123456789", 0, ">", st, 5));
+        assert_eq!((all.as_str(), under.as_str()), (" 1234", "1"));
+        let (all, under) = shown(&edit_spans("123456789", 9, ">", st, 5));
+        assert_eq!((all.as_str(), under.as_str()), (" 789_", "_"));
     }
 }

@@ -83,7 +83,7 @@ pub fn hints(app: &App) -> &'static str {
         return "type to filter  Enter done  Esc clear";
     }
     if app.screen == Screen::Limits && app.limits.edit.is_some() {
-        return "type a value  Enter commit  Esc cancel";
+        return "type a value  <- -> Home End move  Enter commit  Esc cancel";
     }
     match app.screen {
         Screen::Trials => {

@@ -6,7 +6,7 @@
 use crate::model::Model;
 use crate::rotation::{quat_from_euler_zyx_deg, Quat};
 use crate::trial::{ImuSeries, Trial, TrialError, TrialFormat};
-use nalgebra::Quaternion;
+use nalgebra::{Quaternion, Vector3};
 
 /// A quaternion whose norm is further than this from 1 is an error.
 pub(crate) const NORM_TOLERANCE: f64 = 0.01;
@@ -82,6 +82,9 @@ pub(crate) struct ImuCol {
     pub known: bool,
     /// 0-based index of its first field.
     pub first_field: usize,
+    /// 0-based indices of its gyroscope columns `<imu>_gx,<imu>_gy,<imu>_gz`
+    /// (rad/s, sensor frame), when the header has them (CSV only).
+    pub gyro: Option<[usize; 3]>,
 }
 
 /// What the header says: columns, IMUs, and where the data starts.
@@ -98,6 +101,17 @@ pub(crate) struct Layout {
 
 const QUAT_SUFFIXES: [&str; 4] = ["qw", "qx", "qy", "qz"];
 const EULER_SUFFIXES: [&str; 3] = ["roll", "pitch", "yaw"];
+/// Suffixes of the optional gyroscope columns (rad/s, sensor frame).
+pub(crate) const GYRO_SUFFIXES: [&str; 3] = ["gx", "gy", "gz"];
+
+/// `(imu, axis)` of a gyroscope column `<imu>_gx|gy|gz` (axis 0, 1, 2).
+fn gyro_column(field: &str) -> Option<(&str, usize)> {
+    let (prefix, suffix) = split_suffix(field)?;
+    let axis = GYRO_SUFFIXES
+        .iter()
+        .position(|s| suffix.eq_ignore_ascii_case(s))?;
+    (!prefix.is_empty()).then_some((prefix, axis))
+}
 
 fn split_suffix(field: &str) -> Option<(&str, &str)> {
     let i = field.rfind('_')?;
@@ -214,6 +228,7 @@ fn resolve_imus(
             name,
             known,
             first_field: field,
+            gyro: None,
         });
     }
     Ok(imus)
@@ -242,9 +257,15 @@ pub(crate) fn parse_csv_header(
         .join(",");
     check_time_and_count(origin, line, &columns, &pattern)?;
     let mut found = Vec::new();
+    let mut gyros = Vec::new();
     let mut k = 1;
     while k < columns.len() {
         let field = &columns[k];
+        if let Some((imu, axis)) = gyro_column(field) {
+            gyros.push((imu.to_string(), axis, k));
+            k += 1;
+            continue;
+        }
         let prefix = match split_suffix(field) {
             Some((p, s)) if !p.is_empty() && s.eq_ignore_ascii_case(suffixes[0]) => p,
             _ => {
@@ -286,14 +307,98 @@ pub(crate) fn parse_csv_header(
         found.push((prefix.to_string(), k));
         k += suffixes.len();
     }
+    if found.is_empty() {
+        return Err(TrialError::at(
+            origin,
+            line,
+            2,
+            format!("no orientation columns: expected {pattern} for each IMU (gyroscope columns <imu>_gx,<imu>_gy,<imu>_gz come with them)"),
+        ));
+    }
     let mut warnings = Vec::new();
-    let imus = resolve_imus(origin, line, model, found, &mut warnings)?;
+    let mut imus = resolve_imus(origin, line, model, found, &mut warnings)?;
+    attach_gyros(origin, line, model, &columns, &mut imus, gyros)?;
     Ok(Layout {
         columns,
         imus,
         header_line: line,
         warnings,
     })
+}
+
+/// Gives each IMU its gyroscope columns `(imu, axis, field)`: each names an IMU
+/// with orientation columns (as written or through the model's aliases), no
+/// axis twice, all three axes or none.
+fn attach_gyros(
+    origin: &str,
+    line: u64,
+    model: &Model,
+    columns: &[String],
+    imus: &mut [ImuCol],
+    gyros: Vec<(String, usize, usize)>,
+) -> Result<(), TrialError> {
+    let mut partial: Vec<[Option<usize>; 3]> = vec![[None; 3]; imus.len()];
+    for (imu, axis, field) in gyros {
+        let canonical = model.canonical_imu(&imu).unwrap_or(&imu);
+        let Some(k) = imus
+            .iter()
+            .position(|c| c.found == imu || c.name == canonical)
+        else {
+            return Err(TrialError::at(
+                origin,
+                line,
+                field + 1,
+                format!(
+                    "gyroscope column {} names IMU {}, which has no orientation columns; expected gyroscope columns only for IMUs of the file",
+                    show(&columns[field]),
+                    show(&imu)
+                ),
+            ));
+        };
+        if let Some(prev) = partial[k][axis] {
+            return Err(TrialError::at(
+                origin,
+                line,
+                field + 1,
+                format!(
+                    "repeated gyroscope column {} (already column {} {}); expected each of <imu>_gx,<imu>_gy,<imu>_gz once",
+                    show(&columns[field]),
+                    prev + 1,
+                    show(&columns[prev])
+                ),
+            ));
+        }
+        partial[k][axis] = Some(field);
+    }
+    for (c, p) in imus.iter_mut().zip(partial) {
+        match p {
+            [Some(x), Some(y), Some(z)] => c.gyro = Some([x, y, z]),
+            [None, None, None] => {}
+            _ => {
+                let first = p.iter().flatten().min().copied().unwrap_or(0);
+                let missing: Vec<String> = GYRO_SUFFIXES
+                    .iter()
+                    .zip(p)
+                    .filter(|(_, f)| f.is_none())
+                    .map(|(s, _)| format!("'{}_{s}'", c.found))
+                    .collect();
+                return Err(TrialError::at(
+                    origin,
+                    line,
+                    first + 1,
+                    format!(
+                        "incomplete gyroscope columns for {}: missing {}; expected all three of {}_gx,{}_gy,{}_gz (rad/s, sensor frame) or none",
+                        show(&c.found),
+                        missing.join(" and "),
+                        c.found,
+                        c.found,
+                        c.found
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Parses an OpenSim `.sto` header: `key=value` lines up to `endheader`, then the
@@ -412,6 +517,8 @@ struct Acc<'a> {
     time: Vec<f64>,
     last_line: u64,
     series: Vec<Vec<Quat>>,
+    /// Gyroscope readings per IMU (empty for IMUs without gyroscope columns).
+    gyro: Vec<Vec<Vector3<f64>>>,
     renorm: Vec<Renorm>,
 }
 
@@ -422,6 +529,7 @@ impl<'a> Acc<'a> {
             time: Vec::new(),
             last_line: 0,
             series: vec![Vec::new(); n_imus],
+            gyro: vec![Vec::new(); n_imus],
             renorm: vec![Renorm::default(); n_imus],
         }
     }
@@ -520,9 +628,10 @@ impl<'a> Acc<'a> {
             .imus
             .into_iter()
             .zip(self.series)
-            .map(|(c, orientation)| ImuSeries {
-                name: c.name,
-                orientation,
+            .zip(self.gyro)
+            .map(|((c, orientation), gyro)| {
+                let gyro = c.gyro.map(|_| gyro);
+                ImuSeries::new(c.name, orientation).with_gyro(gyro)
             })
             .collect();
         Ok(Trial {
@@ -610,6 +719,7 @@ pub(crate) fn parse_trial(
             let euler = format == TrialFormat::EulerCsv;
             let group = if euler { 3 } else { 4 };
             let mut vals = [0.0f64; 4];
+            let mut cells: Vec<&str> = Vec::with_capacity(ncols);
             for (line, text) in lines.by_ref() {
                 if text.trim().is_empty() {
                     continue;
@@ -618,24 +728,23 @@ pub(crate) fn parse_trial(
                 if nf != ncols {
                     return Err(ragged(origin, line, ncols, nf, "comma"));
                 }
-                let mut cells = text.split(',');
-                let t = number(cells.next().unwrap_or(""), origin, line, 1, "time")?;
+                cells.clear();
+                cells.extend(text.split(','));
+                let cell =
+                    |col: usize| number(cells[col], origin, line, col + 1, &layout.columns[col]);
+                let t = number(cells[0], origin, line, 1, "time")?;
                 acc.push_time(t, line)?;
                 for (k, imu) in layout.imus.iter().enumerate() {
                     for (j, v) in vals.iter_mut().take(group).enumerate() {
-                        let col = imu.first_field + j;
-                        *v = number(
-                            cells.next().unwrap_or(""),
-                            origin,
-                            line,
-                            col + 1,
-                            &layout.columns[col],
-                        )?;
+                        *v = cell(imu.first_field + j)?;
                     }
                     if euler {
                         acc.series[k].push(quat_from_euler_zyx_deg([vals[0], vals[1], vals[2]]));
                     } else {
                         acc.push_quat(k, vals, line, imu.first_field + 1, &imu.found)?;
+                    }
+                    if let Some([x, y, z]) = imu.gyro {
+                        acc.gyro[k].push(Vector3::new(cell(x)?, cell(y)?, cell(z)?));
                     }
                 }
             }

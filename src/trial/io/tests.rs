@@ -7,7 +7,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 
-fn infant() -> Model {
+pub(super) fn infant() -> Model {
     Model::infant13()
 }
 
@@ -17,7 +17,7 @@ fn opensim() -> Model {
 
 /// A trial of `names` with random orientations, pitch kept within +-80 degrees
 /// (away from the Euler singularity) and slightly irregular times.
-fn random_trial(names: &[&str], n: usize, seed: u64) -> Trial {
+pub(super) fn random_trial(names: &[&str], n: usize, seed: u64) -> Trial {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut t = rng.random_range(-5.0..5.0);
     let time_s: Vec<f64> = (0..n)
@@ -28,9 +28,8 @@ fn random_trial(names: &[&str], n: usize, seed: u64) -> Trial {
         .collect();
     let imus = names
         .iter()
-        .map(|name| ImuSeries {
-            name: name.to_string(),
-            orientation: (0..n)
+        .map(|name| {
+            let orientation = (0..n)
                 .map(|_| {
                     let q = quat_from_euler_zyx_deg([
                         rng.random_range(-179.9..179.9),
@@ -44,7 +43,8 @@ fn random_trial(names: &[&str], n: usize, seed: u64) -> Trial {
                         q
                     }
                 })
-                .collect(),
+                .collect();
+            ImuSeries::new(*name, orientation)
         })
         .collect();
     Trial {
@@ -303,7 +303,7 @@ const HDR: &str = "time,base_qw,base_qx,base_qy,base_qz\n";
 const STO_HDR: &str =
     "\nDataRate=100\nDataType=Quaternion\nendheader\ntime\tpelvis_imu\ttorso_imu\n";
 
-fn check(text: &str, format: TrialFormat, line: u64, column: usize, phrase: &str) {
+pub(super) fn check(text: &str, format: TrialFormat, line: u64, column: usize, phrase: &str) {
     let model = if format == S { opensim() } else { infant() };
     let origin = if format == S { "run.sto" } else { "walk.csv" };
     let e = read_trial_from_str(text, origin, format, &model)
