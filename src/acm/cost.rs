@@ -150,6 +150,87 @@ impl PitchRange {
     }
 }
 
+/// The per-sample terms of a joint's limits (METHOD.md section 3): the
+/// excursions beyond the three ranges and the centroid term.
+#[derive(Debug, Clone)]
+pub(super) struct LimitTerms {
+    x: ArcRange,
+    y: PitchRange,
+    z: ArcRange,
+    /// The centroid's rotation, when the term is on (`lambda2 > 0`).
+    pub(super) centroid: Option<Quat>,
+    lambda2: f64,
+}
+
+impl LimitTerms {
+    pub(super) fn new(limits: &JointLimits) -> Self {
+        LimitTerms {
+            x: ArcRange::new(limits.range_deg[0]),
+            y: PitchRange::new(limits.range_deg[1]),
+            z: ArcRange::new(limits.range_deg[2]),
+            centroid: match limits.centroid_deg {
+                Some(c) if limits.lambda2 > 0.0 => Some(quat_from_euler_zyx_deg(c)),
+                _ => None,
+            },
+            lambda2: limits.lambda2,
+        }
+    }
+
+    /// `Ex + Ey + Ez` (degrees) of the Z-Y-X angles of a rotation, from its
+    /// entries `[r00, r10, r20, r21, r22]`.
+    #[inline(always)]
+    pub(super) fn excursion(&self, [r00, r10, r20, r21, r22]: [f64; 5]) -> f64 {
+        self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00)
+    }
+
+    /// `lambda2 * RMSq` for the dot product `d` of a rotation's quaternion and
+    /// the centroid's.
+    #[inline(always)]
+    pub(super) fn centroid_term(&self, d: f64) -> f64 {
+        self.lambda2 * rmsq_of_dot(d)
+    }
+
+    /// The centroid terms summed over quaternions `qs` (`[w, x, y, z]`) dotted
+    /// with `p` (0 without the term).
+    pub(super) fn centroid_sum<'a>(&self, qs: impl Iterator<Item = &'a [f64; 4]>, p: &Quat) -> f64 {
+        if self.centroid.is_none() {
+            return 0.0;
+        }
+        let p = [p.w, p.i, p.j, p.k];
+        let mut sum = 0.0;
+        for q in qs {
+            sum += rmsq_of_dot(q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] * p[3]);
+        }
+        self.lambda2 * sum
+    }
+}
+
+/// [`rmsq`] of two unit quaternions from their dot product `d`: `sqrt(2 - 2|d|)`.
+#[inline(always)]
+fn rmsq_of_dot(d: f64) -> f64 {
+    (2.0 - 2.0 * d.abs()).max(0.0).sqrt()
+}
+
+/// The rows (`rows = true`) or the columns of a rotation's matrix.
+pub(super) fn matrix_vectors(q: &Quat, rows: bool) -> [[f64; 3]; 3] {
+    let m = q.to_rotation_matrix();
+    let m = m.matrix();
+    let v = |i: usize| {
+        if rows {
+            [m[(i, 0)], m[(i, 1)], m[(i, 2)]]
+        } else {
+            [m[(0, i)], m[(1, i)], m[(2, i)]]
+        }
+    };
+    [v(0), v(1), v(2)]
+}
+
+/// `a . b` of 3-vectors.
+#[inline(always)]
+pub(super) fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 /// One sample prepared for fast evaluation: rows of `Rm` and its quaternion.
 #[derive(Debug, Clone, Copy)]
 struct Sample {
@@ -163,11 +244,7 @@ struct Sample {
 #[derive(Debug, Clone)]
 pub struct WindowCost {
     samples: Vec<Sample>,
-    x: ArcRange,
-    y: PitchRange,
-    z: ArcRange,
-    centroid: Option<Quat>,
-    lambda2: f64,
+    terms: LimitTerms,
     lambda1: f64,
 }
 
@@ -189,27 +266,18 @@ impl WindowCost {
     ) -> Self {
         let samples = measured
             .map(|q| {
-                let m = q.to_rotation_matrix();
-                let m = m.matrix();
+                let [row0, row1, row2] = matrix_vectors(q, true);
                 Sample {
-                    row0: [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
-                    row1: [m[(1, 0)], m[(1, 1)], m[(1, 2)]],
-                    row2: [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
+                    row0,
+                    row1,
+                    row2,
                     q: [q.w, q.i, q.j, q.k],
                 }
             })
             .collect();
-        let centroid = match limits.centroid_deg {
-            Some(c) if limits.lambda2 > 0.0 => Some(quat_from_euler_zyx_deg(c)),
-            _ => None,
-        };
         WindowCost {
             samples,
-            x: ArcRange::new(limits.range_deg[0]),
-            y: PitchRange::new(limits.range_deg[1]),
-            z: ArcRange::new(limits.range_deg[2]),
-            centroid,
-            lambda2: limits.lambda2,
+            terms: LimitTerms::new(limits),
             lambda1,
         }
     }
@@ -231,31 +299,22 @@ impl WindowCost {
         if self.samples.is_empty() {
             return penalty;
         }
-        let m = c.to_rotation_matrix();
-        let m = m.matrix();
-        let col0 = [m[(0, 0)], m[(1, 0)], m[(2, 0)]];
-        let col1 = [m[(0, 1)], m[(1, 1)], m[(2, 1)]];
-        let col2 = [m[(0, 2)], m[(1, 2)], m[(2, 2)]];
-        let dot = |r: &[f64; 3], k: &[f64; 3]| r[0] * k[0] + r[1] * k[1] + r[2] * k[2];
+        let [col0, col1, col2] = matrix_vectors(c, false);
         let mut sum = 0.0;
         for s in &self.samples {
-            let r20 = dot(&s.row2, &col0);
-            let r21 = dot(&s.row2, &col1);
-            let r22 = dot(&s.row2, &col2);
-            let r10 = dot(&s.row1, &col0);
-            let r00 = dot(&s.row0, &col0);
-            sum += self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00);
+            sum += self.terms.excursion([
+                dot3(&s.row0, &col0),
+                dot3(&s.row1, &col0),
+                dot3(&s.row2, &col0),
+                dot3(&s.row2, &col1),
+                dot3(&s.row2, &col2),
+            ]);
         }
-        if let Some(qc) = self.centroid {
+        if let Some(qc) = self.terms.centroid {
             // qt . qc = qm . (qc * c^-1), so one 4-vector per evaluation.
-            let p = qc * c.inverse();
-            let p = [p.w, p.i, p.j, p.k];
-            let mut centroid_sum = 0.0;
-            for s in &self.samples {
-                let d = s.q[0] * p[0] + s.q[1] * p[1] + s.q[2] * p[2] + s.q[3] * p[3];
-                centroid_sum += (2.0 - 2.0 * d.abs()).max(0.0).sqrt();
-            }
-            sum += self.lambda2 * centroid_sum;
+            sum += self
+                .terms
+                .centroid_sum(self.samples.iter().map(|s| &s.q), &(qc * c.inverse()));
         }
         sum / self.samples.len() as f64 + penalty
     }

@@ -14,9 +14,9 @@
 //! `e(C, h) = (1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i)
 //!            + lambda1 * angle(C) + lambda1 * |h|` (degrees).
 
-use super::cost::{ArcRange, PitchRange};
+use super::cost::LimitTerms;
 use crate::limits::JointLimits;
-use crate::rotation::{angle_deg, quat_from_euler_zyx_deg, Quat};
+use crate::rotation::{angle_deg, Quat};
 use nalgebra::{Matrix3, Quaternion};
 
 /// The entries `r00, r10, r20, r21, r22` of a rotation matrix.
@@ -40,11 +40,7 @@ struct Sample {
 #[derive(Debug, Clone)]
 pub struct HeadingCost {
     samples: Vec<Sample>,
-    x: ArcRange,
-    y: PitchRange,
-    z: ArcRange,
-    centroid: bool,
-    lambda2: f64,
+    terms: LimitTerms,
     lambda1: f64,
     /// `lambda1 * angle(C)`.
     c_penalty: f64,
@@ -70,10 +66,8 @@ impl HeadingCost {
             -up[1], up[0], 0.0,
         );
         let k2 = k * k;
-        let centroid = match limits.centroid_deg {
-            Some(c) if limits.lambda2 > 0.0 => Some(quat_from_euler_zyx_deg(c)),
-            _ => None,
-        };
+        let terms = LimitTerms::new(limits);
+        let centroid = terms.centroid;
         let minus_up = Quaternion::new(0.0, -up[0], -up[1], -up[2]);
         let samples = parent
             .iter()
@@ -102,11 +96,7 @@ impl HeadingCost {
             .collect();
         HeadingCost {
             samples,
-            x: ArcRange::new(limits.range_deg[0]),
-            y: PitchRange::new(limits.range_deg[1]),
-            z: ArcRange::new(limits.range_deg[2]),
-            centroid: centroid.is_some(),
-            lambda2: limits.lambda2,
+            terms,
             lambda1,
             c_penalty: lambda1 * angle_deg(c),
         }
@@ -131,14 +121,15 @@ impl HeadingCost {
         let (s, c) = h_deg.to_radians().sin_cos();
         let v = 1.0 - c;
         let (sh, ch) = (0.5 * h_deg.to_radians()).sin_cos();
+        let centroid = self.terms.centroid.is_some();
         let mut sum = 0.0;
         for p in &self.samples {
             let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
-            let (r00, r10, r20, r21, r22) = (r(0), r(1), r(2), r(3), r(4));
-            sum += self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00);
-            if self.centroid {
-                let d = ch * p.centroid_dots[0] + sh * p.centroid_dots[1];
-                sum += self.lambda2 * (2.0 - 2.0 * d.abs()).max(0.0).sqrt();
+            sum += self.terms.excursion([r(0), r(1), r(2), r(3), r(4)]);
+            if centroid {
+                sum += self
+                    .terms
+                    .centroid_term(ch * p.centroid_dots[0] + sh * p.centroid_dots[1]);
             }
         }
         sum / self.samples.len() as f64 + penalty

@@ -14,9 +14,9 @@
 //! distal IMU's correction are counted by the caller, once each):
 //! `(1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i)`, degrees.
 
-use super::cost::{ArcRange, PitchRange};
+use super::cost::{dot3, matrix_vectors, LimitTerms};
 use crate::limits::JointLimits;
-use crate::rotation::{quat_from_euler_zyx_deg, Quat};
+use crate::rotation::Quat;
 
 /// One sample: the columns of `B` and its quaternion `[w, x, y, z]`.
 #[derive(Debug, Clone, Copy)]
@@ -31,11 +31,7 @@ struct Sample {
 #[derive(Debug, Clone)]
 pub struct ParentCost {
     samples: Vec<Sample>,
-    x: ArcRange,
-    y: PitchRange,
-    z: ArcRange,
-    centroid: Option<Quat>,
-    lambda2: f64,
+    terms: LimitTerms,
 }
 
 impl ParentCost {
@@ -43,27 +39,18 @@ impl ParentCost {
     pub fn new(b: impl Iterator<Item = Quat>, limits: &JointLimits) -> Self {
         let samples = b
             .map(|q| {
-                let m = q.to_rotation_matrix();
-                let m = m.matrix();
+                let [col0, col1, col2] = matrix_vectors(&q, false);
                 Sample {
-                    col0: [m[(0, 0)], m[(1, 0)], m[(2, 0)]],
-                    col1: [m[(0, 1)], m[(1, 1)], m[(2, 1)]],
-                    col2: [m[(0, 2)], m[(1, 2)], m[(2, 2)]],
+                    col0,
+                    col1,
+                    col2,
                     q: [q.w, q.i, q.j, q.k],
                 }
             })
             .collect();
-        let centroid = match limits.centroid_deg {
-            Some(c) if limits.lambda2 > 0.0 => Some(quat_from_euler_zyx_deg(c)),
-            _ => None,
-        };
         ParentCost {
             samples,
-            x: ArcRange::new(limits.range_deg[0]),
-            y: PitchRange::new(limits.range_deg[1]),
-            z: ArcRange::new(limits.range_deg[2]),
-            centroid,
-            lambda2: limits.lambda2,
+            terms: LimitTerms::new(limits),
         }
     }
 
@@ -84,30 +71,21 @@ impl ParentCost {
             return 0.0;
         }
         // Rows of C_p^T are the columns of C_p.
-        let m = c_p.to_rotation_matrix();
-        let m = m.matrix();
-        let row0 = [m[(0, 0)], m[(1, 0)], m[(2, 0)]];
-        let row1 = [m[(0, 1)], m[(1, 1)], m[(2, 1)]];
-        let row2 = [m[(0, 2)], m[(1, 2)], m[(2, 2)]];
-        let dot = |r: &[f64; 3], k: &[f64; 3]| r[0] * k[0] + r[1] * k[1] + r[2] * k[2];
+        let [row0, row1, row2] = matrix_vectors(c_p, false);
         let mut sum = 0.0;
         for s in &self.samples {
-            let r00 = dot(&row0, &s.col0);
-            let r10 = dot(&row1, &s.col0);
-            let r20 = dot(&row2, &s.col0);
-            let r21 = dot(&row2, &s.col1);
-            let r22 = dot(&row2, &s.col2);
-            sum += self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00);
+            sum += self.terms.excursion([
+                dot3(&row0, &s.col0),
+                dot3(&row1, &s.col0),
+                dot3(&row2, &s.col0),
+                dot3(&row2, &s.col1),
+                dot3(&row2, &s.col2),
+            ]);
         }
-        if let Some(qc) = self.centroid {
-            let p = c_p * qc;
-            let p = [p.w, p.i, p.j, p.k];
-            let mut centroid_sum = 0.0;
-            for s in &self.samples {
-                let d = s.q[0] * p[0] + s.q[1] * p[1] + s.q[2] * p[2] + s.q[3] * p[3];
-                centroid_sum += (2.0 - 2.0 * d.abs()).max(0.0).sqrt();
-            }
-            sum += self.lambda2 * centroid_sum;
+        if let Some(qc) = self.terms.centroid {
+            sum += self
+                .terms
+                .centroid_sum(self.samples.iter().map(|s| &s.q), &(c_p * qc));
         }
         sum / self.samples.len() as f64
     }
