@@ -260,3 +260,35 @@ fn writing_gyros_to_sto_warns_that_they_are_dropped() {
     assert!(run("sto").contains("gyroscope readings are not written"));
     assert!(!run("quat-csv").contains("gyroscope"));
 }
+
+#[test]
+fn render_reads_every_trial_with_the_model_it_is_given() {
+    // A lab's own model: the trials are read with it, not with the built-in
+    // model that knows most of their IMUs.
+    let dir = tempfile::tempdir().unwrap();
+    simulated(dir.path());
+    let ours =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("models/infant13.toml"))
+            .unwrap()
+            .replace("name = \"infant13\"", "name = \"our_suit\"");
+    std::fs::write(dir.path().join("our_suit.toml"), ours).unwrap();
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", "trials", "--dir", ".", "--size", "120x40"];
+        args.extend_from_slice(extra);
+        acmw(dir.path(), &args)
+    };
+    let out = render(&["--model", "our_suit.toml"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("model our_suit"),
+        "{text}"
+    );
+    let text = String::from_utf8(render(&[]).stdout).unwrap();
+    assert!(text.contains("model infant13"), "{text}");
+    // A malformed model is bad input, located.
+    std::fs::write(dir.path().join("bad.toml"), "name = \"x\"\nbase = 3\n").unwrap();
+    let out = render(&["--model", "bad.toml"]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.toml:"), "{err}");
+}

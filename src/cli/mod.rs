@@ -60,6 +60,11 @@ pub struct Cli {
     /// [default: ./joint_limits; the built-in tables when it has none].
     #[arg(long, value_name = "DIR")]
     pub limits_dir: Option<PathBuf>,
+    /// Body model the workbench reads every trial with: `infant13`, `opensim`,
+    /// `opensense_lower`, `full_body16` or a model TOML file [default: per
+    /// trial, the built-in model that knows most of its IMUs].
+    #[arg(long)]
+    pub model: Option<String>,
     /// Colour theme of the workbench: dark, light or high-contrast (NO_COLOR is honoured).
     #[arg(long, global = true, default_value = "dark")]
     pub theme: String,
@@ -97,7 +102,7 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::Centroids(a)) => analysis::run_centroids(a),
         Some(Command::Plot(a)) => plot::run(a),
         Some(Command::Calibrate(a)) => calibrate::run(a),
-        None => workbench(cli.dir, &cli.theme, cli.limits_dir),
+        None => workbench(cli.dir, &cli.theme, cli.limits_dir, cli.model),
     };
     match result {
         Ok(code) => code,
@@ -127,6 +132,7 @@ fn workbench(
     dir: Option<PathBuf>,
     theme: &str,
     limits_dir: Option<PathBuf>,
+    model: Option<String>,
 ) -> anyhow::Result<i32> {
     use std::io::IsTerminal;
     if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
@@ -138,9 +144,13 @@ fn workbench(
     let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
     let theme =
         acm_workbench::ui::theme::Theme::builtin(theme, no_color).map_err(anyhow::Error::msg)?;
+    let model = model
+        .map(|m| acm_workbench::model::Model::load(&m))
+        .transpose()?;
     acm_workbench::ui::runtime::run(acm_workbench::ui::runtime::Options {
         dir: dir.unwrap_or_else(|| PathBuf::from("sample_trials")),
         limits_dir: limits_dir.unwrap_or_else(common::default_limits_dir),
+        model,
         theme,
     })?;
     Ok(EXIT_OK)

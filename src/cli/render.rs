@@ -2,7 +2,9 @@
 //! code as the terminal (and the snapshot tests).
 
 use acm_workbench::acm::Variant;
-use acm_workbench::ui::headless::{buffer_ansi, buffer_text, draw, load_app, show, Show, SCREENS};
+use acm_workbench::ui::headless::{
+    buffer_ansi, buffer_text, draw, load_app_with, show, Show, SCREENS,
+};
 use acm_workbench::ui::theme::Theme;
 use anyhow::anyhow;
 use clap::Args;
@@ -20,6 +22,10 @@ pub struct RenderArgs {
     /// Folder of limit tables and settings.toml [default: ./joint_limits].
     #[arg(long, value_name = "DIR")]
     pub limits_dir: Option<PathBuf>,
+    /// Body model to read the trials with (built-in name or TOML file)
+    /// [default: per trial, the built-in model that knows most of its IMUs].
+    #[arg(long)]
+    pub model: Option<String>,
     /// Trial file name inside the folder [default: the first readable one].
     #[arg(long)]
     pub trial: Option<String>,
@@ -54,8 +60,13 @@ pub fn run(a: RenderArgs, theme: &str) -> anyhow::Result<i32> {
         .unwrap_or_else(super::common::default_limits_dir);
     // Read first for a located error and exit code 3 on a malformed table.
     acm_workbench::limits::LimitsDir::load(&limits_dir)?;
-    let mut app =
-        load_app(&dir.display().to_string(), &dir, &limits_dir).map_err(|e| anyhow!(e))?;
+    let model = a
+        .model
+        .as_deref()
+        .map(acm_workbench::model::Model::load)
+        .transpose()?;
+    let label = dir.display().to_string();
+    let mut app = load_app_with(&label, &dir, &limits_dir, model).map_err(|e| anyhow!(e))?;
     show(
         &mut app,
         &Show {

@@ -457,6 +457,9 @@ pub struct App {
     pub selected: usize,
     pub filter: String,
     pub filter_editing: bool,
+    /// The body model every trial is read with (`--model`); None: each
+    /// trial's is detected from its IMU names among the built-in models.
+    pub model: Option<Arc<Model>>,
     pub sort: SortKey,
     pub variant: Variant,
     /// The trial open on the trial and compare screens (file name).
@@ -490,6 +493,8 @@ pub enum Effect {
         limits: LimitTable,
         /// Glitch threshold, degrees (`settings.toml`).
         glitch_deg: f64,
+        /// The model to read them with (None: detected per trial).
+        model: Option<Arc<Model>>,
     },
     /// Correct a trial with every variant (replacing any job of the same trial),
     /// or re-correct `joints` of the previous results.
@@ -605,6 +610,7 @@ impl App {
             selected: 0,
             filter: String::new(),
             filter_editing: false,
+            model: None,
             sort: SortKey::Name,
             variant: Variant::Drift,
             open: None,
@@ -638,6 +644,7 @@ impl App {
                 .collect(),
             limits: self.limits.table.clone(),
             glitch_deg: self.limits.settings.glitch_deg,
+            model: self.model.clone(),
         }]
     }
 
@@ -798,6 +805,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                 files: vec![(file, path)],
                 limits: app.limits.table.clone(),
                 glitch_deg: app.limits.settings.glitch_deg,
+                model: app.model.clone(),
             }]
         }
         Msg::FileRemoved(file) => {

@@ -7,6 +7,7 @@ use super::jobs::{list_trials, load_limits, SyncRunner};
 use super::render::render;
 use super::theme::Theme;
 use crate::acm::Variant;
+use crate::model::Model;
 use ratatui::backend::TestBackend;
 use ratatui::buffer::{Buffer, CellWidth};
 use ratatui::style::{Color, Modifier};
@@ -32,9 +33,20 @@ pub const SCREENS: [&str; 12] = [
 
 /// A workbench over `dir` (shown as `dir_label`) with every trial read.
 pub fn load_app(dir_label: &str, dir: &Path, limits_dir: &Path) -> Result<App, String> {
+    load_app_with(dir_label, dir, limits_dir, None)
+}
+
+/// As [`load_app`], every trial read with `model` (None: detected per trial).
+pub fn load_app_with(
+    dir_label: &str,
+    dir: &Path,
+    limits_dir: &Path,
+    model: Option<Model>,
+) -> Result<App, String> {
     let files = list_trials(dir)?;
     let limits = load_limits(limits_dir)?;
     let mut app = App::new(dir_label.to_string(), dir.to_path_buf(), files, limits);
+    app.model = model.map(std::sync::Arc::new);
     let start = app.start();
     SyncRunner::run(&mut app, start);
     Ok(app)

@@ -6,6 +6,7 @@ use super::app::{update, App, Effect, LimitsState, Loaded, Msg, RunJob};
 use crate::acm::{correct_trial, recorrect, Correction, RunControl, Variant};
 use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
+use crate::model::Model;
 use crate::report::ReportInput;
 use crate::sidecar::{default_output, SaveRequest};
 use crate::trial::glitch::glitches;
@@ -73,8 +74,15 @@ pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<(LimitTable, 
 }
 
 /// Reads one trial: the trial, its model, its truth and its uncorrected figures.
-/// Orientation jumps over `glitch_deg` (degrees) are flagged.
-pub fn load_trial(file: &str, path: &Path, limits: &LimitTable, glitch_deg: f64) -> Msg {
+/// Orientation jumps over `glitch_deg` (degrees) are flagged. `model` is the
+/// body model to read it with; None detects it from the trial's IMU names.
+pub fn load_trial(
+    file: &str,
+    path: &Path,
+    limits: &LimitTable,
+    glitch_deg: f64,
+    model: Option<&Model>,
+) -> Msg {
     let shown = |e: TrialError| {
         TrialError {
             file: file.to_string(),
@@ -83,7 +91,7 @@ pub fn load_trial(file: &str, path: &Path, limits: &LimitTable, glitch_deg: f64)
         .to_string()
     };
     let result = (|| {
-        let model = detect_model(path);
+        let model = model.cloned().unwrap_or_else(|| detect_model(path));
         let (format, gzip) = detect_format(path).map_err(shown)?;
         let mut trial = read_trial(path, &model).map_err(shown)?;
         trial.name = file.to_string();
@@ -235,9 +243,10 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
             files,
             limits,
             glitch_deg,
+            model,
         } => files
             .iter()
-            .map(|(f, p)| load_trial(f, p, &limits, glitch_deg))
+            .map(|(f, p)| load_trial(f, p, &limits, glitch_deg, model.as_deref()))
             .collect(),
         Effect::Run(job) => {
             let cancel = AtomicBool::new(false);

@@ -63,6 +63,8 @@ pub struct Options {
     pub dir: PathBuf,
     /// The limits folder (normally `./joint_limits`).
     pub limits_dir: PathBuf,
+    /// The body model of every trial (None: detected per trial).
+    pub model: Option<crate::model::Model>,
     pub theme: Theme,
 }
 
@@ -73,6 +75,7 @@ pub fn run(opts: Options) -> anyhow::Result<()> {
     let limits = load_limits(&opts.limits_dir).map_err(anyhow::Error::msg)?;
     let label = opts.dir.display().to_string();
     let mut app = App::new(label, opts.dir.clone(), files, limits);
+    app.model = opts.model.clone().map(Arc::new);
 
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
@@ -218,11 +221,14 @@ impl Workers {
                 files,
                 limits,
                 glitch_deg,
+                model,
             } => {
                 std::thread::spawn(move || {
                     use rayon::prelude::*;
                     files.par_iter().for_each(|(f, p)| {
-                        let _ = tx.send(Event::Msg(jobs::load_trial(f, p, &limits, glitch_deg)));
+                        let m = model.as_deref();
+                        let msg = jobs::load_trial(f, p, &limits, glitch_deg, m);
+                        let _ = tx.send(Event::Msg(msg));
                     });
                 });
             }
