@@ -2,22 +2,9 @@
 //! writes the method's record into the sidecar, the sidecar reproduces the
 //! output byte for byte (whatever the thread count), and `report` lists them.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn acmw(dir: &Path, args: &[&str]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_acmw"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "acmw {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
+use common::acmw_ok as acmw;
 
 #[test]
 fn baselines_correct_reproduce_and_report() {

@@ -1,25 +1,10 @@
 //! `acmw calibrate`, `acmw simulate calibration`, and trials corrected with a
 //! calibration applied first (`--calibration`), against simulated truth.
 
+mod common;
+
+use common::{acmw, ok};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn acmw(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_acmw"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
 
 /// The calibrated IMUs of the default protocol.
 const IMUS: [&str; 5] = [

@@ -1,15 +1,10 @@
 //! The `acmw` command line: correct, reproduce from a sidecar, report, errors.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn acmw(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_acmw"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
+use common::acmw;
+use std::path::Path;
+use std::process::Command;
 
 fn simulated(dir: &Path) {
     let out = acmw(

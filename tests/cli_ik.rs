@@ -1,24 +1,9 @@
 //! `acmw correct/report --pose-calibration` and `--variant ik` end to end.
 
+mod common;
+
+use common::{acmw, ok};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn acmw(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_acmw"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
 
 fn simulated(dir: &Path) {
     ok(&acmw(
