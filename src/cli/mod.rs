@@ -65,6 +65,10 @@ pub struct Cli {
     /// trial, the built-in model that knows most of its IMUs].
     #[arg(long)]
     pub model: Option<String>,
+    /// Watch the trials and limits folders by reading them every SECONDS, for
+    /// network file systems that deliver no change notifications.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_poll)]
+    pub poll: Option<f64>,
     /// Colour theme of the workbench: dark, light or high-contrast (NO_COLOR is honoured).
     #[arg(long, global = true, default_value = "dark")]
     pub theme: String,
@@ -102,7 +106,7 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::Centroids(a)) => analysis::run_centroids(a),
         Some(Command::Plot(a)) => plot::run(a),
         Some(Command::Calibrate(a)) => calibrate::run(a),
-        None => workbench(cli.dir, &cli.theme, cli.limits_dir, cli.model),
+        None => workbench(cli.dir, &cli.theme, cli.limits_dir, cli.model, cli.poll),
     };
     match result {
         Ok(code) => code,
@@ -133,6 +137,7 @@ fn workbench(
     theme: &str,
     limits_dir: Option<PathBuf>,
     model: Option<String>,
+    poll: Option<f64>,
 ) -> anyhow::Result<i32> {
     use std::io::IsTerminal;
     if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
@@ -151,9 +156,20 @@ fn workbench(
         dir: dir.unwrap_or_else(|| PathBuf::from("sample_trials")),
         limits_dir: limits_dir.unwrap_or_else(common::default_limits_dir),
         model,
+        poll: poll.map(std::time::Duration::from_secs_f64),
         theme,
     })?;
     Ok(EXIT_OK)
+}
+
+/// A polling interval in seconds: positive and at most a day.
+fn parse_poll(s: &str) -> Result<f64, String> {
+    let v: f64 = s.trim().parse().map_err(|e| format!("'{s}': {e}"))?;
+    if v > 0.0 && v <= 86_400.0 {
+        Ok(v)
+    } else {
+        Err(format!("expected seconds in (0, 86400], found {s}"))
+    }
 }
 
 /// Whether an error comes from malformed input data (exit code 3).

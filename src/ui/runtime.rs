@@ -16,7 +16,7 @@ fn is_xml(p: &Path) -> bool {
 }
 use crossbeam_channel::{unbounded, Receiver, Sender};
 use notify::RecursiveMode;
-use notify_debouncer_full::{new_debouncer, DebounceEventResult};
+use notify_debouncer_full::{new_debouncer, new_debouncer_opt, DebounceEventResult};
 use ratatui::backend::CrosstermBackend;
 use ratatui::crossterm::event::{self, DisableMouseCapture, EnableMouseCapture, Event as CtEvent};
 use ratatui::crossterm::terminal::{
@@ -65,6 +65,9 @@ pub struct Options {
     pub limits_dir: PathBuf,
     /// The body model of every trial (None: detected per trial).
     pub model: Option<crate::model::Model>,
+    /// Watch the folders by reading them at this interval instead of through
+    /// the system's change notifications (network file systems).
+    pub poll: Option<Duration>,
     pub theme: Theme,
 }
 
@@ -116,57 +119,85 @@ fn spawn_signals(tx: Sender<Event>) {
     });
 }
 
-type Watcher = notify_debouncer_full::Debouncer<
-    notify::RecommendedWatcher,
-    notify_debouncer_full::RecommendedCache,
->;
+/// A folder watcher, kept alive while held: the system's notifications, or
+/// polling for file systems that do not deliver them (network mounts).
+#[allow(dead_code)] // held for its Drop, never read
+pub enum Watcher {
+    Native(
+        notify_debouncer_full::Debouncer<
+            notify::RecommendedWatcher,
+            notify_debouncer_full::RecommendedCache,
+        >,
+    ),
+    Poll(notify_debouncer_full::Debouncer<notify::PollWatcher, notify_debouncer_full::NoCache>),
+}
 
 /// Paths whose content, name or existence changed. Reading a file (ours
 /// included) raises access events and metadata changes touch no content:
-/// neither counts, or every read would trigger a reload.
+/// neither counts, or every read would trigger a reload. When polling, a newer
+/// modification time is how a changed content shows (reads do not change it).
 fn changed_paths(
     events: &[notify_debouncer_full::DebouncedEvent],
+    polling: bool,
 ) -> impl Iterator<Item = &PathBuf> {
-    use notify::event::{EventKind, ModifyKind};
+    use notify::event::{EventKind, MetadataKind, ModifyKind};
     events
         .iter()
-        .filter(|e| {
-            matches!(
-                e.kind,
-                EventKind::Create(_)
-                    | EventKind::Remove(_)
-                    | EventKind::Modify(
-                        ModifyKind::Data(_) | ModifyKind::Name(_) | ModifyKind::Any
-                    )
-            )
+        .filter(move |e| match e.kind {
+            EventKind::Create(_)
+            | EventKind::Remove(_)
+            | EventKind::Modify(ModifyKind::Data(_) | ModifyKind::Name(_) | ModifyKind::Any) => {
+                true
+            }
+            EventKind::Modify(ModifyKind::Metadata(MetadataKind::WriteTime)) => polling,
+            _ => false,
         })
         .flat_map(|e| e.paths.iter())
 }
 
 /// Watches `dir` (non-recursive, debounced 250 ms) and hands each batch of
-/// content changes ([`changed_paths`]) to `on_change`.
-fn watch_folder(dir: &Path, on_change: impl Fn(Vec<PathBuf>) + Send + 'static) -> Option<Watcher> {
-    let mut w = new_debouncer(
-        Duration::from_millis(250),
-        None,
-        move |r: DebounceEventResult| {
-            if let Ok(events) = r {
-                let paths: Vec<PathBuf> = changed_paths(&events).cloned().collect();
-                if !paths.is_empty() {
-                    on_change(paths);
-                }
+/// content changes ([`changed_paths`]) to `on_change`; with `poll`, by reading
+/// the folder at that interval instead of through the system's notifications.
+pub fn watch_folder(
+    dir: &Path,
+    poll: Option<Duration>,
+    on_change: impl Fn(Vec<PathBuf>) + Send + 'static,
+) -> Option<Watcher> {
+    let debounce = Duration::from_millis(250);
+    let handler = move |r: DebounceEventResult| {
+        if let Ok(events) = r {
+            let paths: Vec<PathBuf> = changed_paths(&events, poll.is_some()).cloned().collect();
+            if !paths.is_empty() {
+                on_change(paths);
             }
-        },
-    )
-    .ok()?;
-    w.watch(dir, RecursiveMode::NonRecursive).ok()?;
-    Some(w)
+        }
+    };
+    match poll {
+        None => {
+            let mut w = new_debouncer(debounce, None, handler).ok()?;
+            w.watch(dir, RecursiveMode::NonRecursive).ok()?;
+            Some(Watcher::Native(w))
+        }
+        Some(every) => {
+            let config = notify::Config::default().with_poll_interval(every);
+            let mut w = new_debouncer_opt::<_, notify::PollWatcher, _>(
+                debounce,
+                None,
+                handler,
+                notify_debouncer_full::NoCache,
+                config,
+            )
+            .ok()?;
+            w.watch(dir, RecursiveMode::NonRecursive).ok()?;
+            Some(Watcher::Poll(w))
+        }
+    }
 }
 
 /// Watches the trials folder: changed and removed trial files.
-fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
+fn watch_trials(dir: &Path, poll: Option<Duration>, tx: Sender<Event>) -> Option<Watcher> {
     let d = dir.to_path_buf();
-    watch_folder(dir, move |paths| {
+    watch_folder(dir, poll, move |paths| {
         let names: BTreeSet<String> = paths
             .iter()
             .filter(|p| is_trial_file(p) || is_xml(p) || p.is_dir())
@@ -187,12 +218,17 @@ fn watch_trials(dir: &Path, tx: Sender<Event>) -> Option<Watcher> {
 }
 
 /// Watches the limits folder: a changed table or settings file is re-read.
-fn watch_limits(dir: &Path, table: String, tx: Sender<Event>) -> Option<Watcher> {
+fn watch_limits(
+    dir: &Path,
+    table: String,
+    poll: Option<Duration>,
+    tx: Sender<Event>,
+) -> Option<Watcher> {
     if !dir.is_dir() {
         return None;
     }
     let d = dir.to_path_buf();
-    watch_folder(dir, move |paths| {
+    watch_folder(dir, poll, move |paths| {
         let relevant = paths.iter().any(|p| {
             p.file_name()
                 .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
@@ -283,9 +319,13 @@ fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
     draw(&mut terminal, app, &opts.theme)?;
     spawn_input(tx.clone());
     spawn_signals(tx.clone());
-    let _trials_watch = watch_trials(&opts.dir, tx.clone());
-    let mut limits_watch =
-        watch_limits(&opts.limits_dir, app.limits.table_name.clone(), tx.clone());
+    let _trials_watch = watch_trials(&opts.dir, opts.poll, tx.clone());
+    let mut limits_watch = watch_limits(
+        &opts.limits_dir,
+        app.limits.table_name.clone(),
+        opts.poll,
+        tx.clone(),
+    );
     let mut workers = Workers {
         tx: tx.clone(),
         dir: opts.dir.clone(),
@@ -342,6 +382,7 @@ fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
                         limits_watch = watch_limits(
                             &opts.limits_dir,
                             app.limits.table_name.clone(),
+                            opts.poll,
                             tx.clone(),
                         );
                     }
@@ -363,4 +404,72 @@ fn keep_unsaved(app: &App) {
     let _ = std::fs::create_dir_all(&l.dir);
     let path = l.dir.join(format!("{}.unsaved", l.table_name));
     let _ = crate::save::atomic_write(&path, l.table.to_csv().as_bytes());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use notify::event::{AccessKind, DataChange, EventKind, MetadataKind, ModifyKind};
+    use notify_debouncer_full::DebouncedEvent;
+
+    fn event(kind: EventKind, path: &str) -> DebouncedEvent {
+        DebouncedEvent::new(
+            notify::Event::new(kind).add_path(path.into()),
+            Instant::now(),
+        )
+    }
+
+    #[test]
+    fn a_newer_write_time_counts_only_when_polling() {
+        let events = [
+            event(EventKind::Access(AccessKind::Any), "read.csv"),
+            event(
+                EventKind::Modify(ModifyKind::Metadata(MetadataKind::WriteTime)),
+                "written.csv",
+            ),
+            event(
+                EventKind::Modify(ModifyKind::Metadata(MetadataKind::Permissions)),
+                "chmod.csv",
+            ),
+            event(
+                EventKind::Modify(ModifyKind::Data(DataChange::Any)),
+                "data.csv",
+            ),
+        ];
+        let names = |polling| -> Vec<String> {
+            changed_paths(&events, polling)
+                .map(|p| p.display().to_string())
+                .collect()
+        };
+        assert_eq!(names(false), ["data.csv"]);
+        assert_eq!(names(true), ["written.csv", "data.csv"]);
+    }
+
+    #[test]
+    fn polling_sees_a_new_file_and_an_atomic_save() {
+        let dir = tempfile::tempdir().unwrap();
+        let (tx, rx) = unbounded();
+        let poll = Some(Duration::from_millis(50));
+        let _w = watch_folder(dir.path(), poll, move |paths| {
+            let _ = tx.send(paths);
+        })
+        .expect("a poll watcher starts on any folder");
+        let file = dir.path().join("t.csv");
+        // Each change must arrive; the deadline only keeps a broken watcher
+        // from hanging the suite.
+        let arrives = |what: &str| loop {
+            let paths = rx
+                .recv_timeout(Duration::from_secs(20))
+                .unwrap_or_else(|_| panic!("no change seen after {what}"));
+            if paths.contains(&file) {
+                break;
+            }
+        };
+        std::fs::write(&file, "time\n").unwrap();
+        arrives("creating the file");
+        // A save one second later (modification times may be coarse).
+        std::thread::sleep(Duration::from_millis(1100));
+        crate::save::atomic_write(&file, b"time,x\n").unwrap();
+        arrives("an atomic save over it");
+    }
 }
