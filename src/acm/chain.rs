@@ -252,7 +252,7 @@ fn run(
                         control,
                         &progress,
                     )?;
-                    let applied = Applied::Baseline(sol.series, gyro);
+                    let applied = Applied::Series(sol.series, GyroUpdate::Replace(gyro));
                     return Ok((*k, result(sol.windows, baseline), applied, None));
                 }
                 let sol = solve_windows(
@@ -264,7 +264,7 @@ fn run(
                     control,
                     &progress,
                 )?;
-                let applied = Applied::Series(sol.series);
+                let applied = Applied::Series(sol.series, GyroUpdate::Turn);
                 Ok((*k, result(sol.windows, None), applied, None))
             })
             .collect::<Result<_, Cancelled>>()?;
@@ -275,21 +275,19 @@ fn run(
             let distal = &model.joints[k].distal;
             let imu = corrected.imu_mut(distal).expect("present");
             match applied {
-                Applied::Series(series) => {
+                Applied::Series(series, gyro) => {
                     for (q, c) in imu.orientation.iter_mut().zip(&series) {
                         *q = Quat::new_normalize((*q * c).into_inner());
                     }
-                    if let Some(g) = &mut imu.gyro {
-                        for (w, c) in g.iter_mut().zip(&series) {
-                            *w = c.inverse() * *w;
+                    match (gyro, &mut imu.gyro) {
+                        (GyroUpdate::Turn, Some(g)) => {
+                            for (w, c) in g.iter_mut().zip(&series) {
+                                *w = c.inverse() * *w;
+                            }
                         }
+                        (GyroUpdate::Turn, None) => {}
+                        (GyroUpdate::Replace(g), _) => imu.gyro = g,
                     }
-                }
-                Applied::Baseline(series, gyro) => {
-                    for (q, c) in imu.orientation.iter_mut().zip(&series) {
-                        *q = Quat::new_normalize((*q * c).into_inner());
-                    }
-                    imu.gyro = gyro;
                 }
                 Applied::Kept(orientation, gyro) => {
                     imu.orientation = orientation;
@@ -318,19 +316,26 @@ fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &s
     results.keys().any(|&k| model.joints[k].distal == imu)
 }
 
-/// A baseline's corrected distal gyros (`None`: dropped).
-type BaselineGyro = Option<Vec<Vector3<f64>>>;
+/// Gyroscope readings of one IMU (rad/s, sensor frame), or none.
+type Gyros = Option<Vec<Vector3<f64>>>;
 
 /// What a joint's run gives its distal IMU.
 enum Applied {
-    /// A fresh per-sample correction `C(t)`, to apply as `G_R_dist * C(t)`
-    /// (and `C(t)^-1 w` to the gyros).
-    Series(Vec<Quat>),
-    /// A baseline's `C(t)`, applied likewise, and the gyros to take instead.
-    Baseline(Vec<Quat>, BaselineGyro),
+    /// A fresh per-sample correction `C(t)`, to apply as `G_R_dist * C(t)`,
+    /// and what becomes of the gyros.
+    Series(Vec<Quat>, GyroUpdate),
     /// Corrected orientations and gyroscope readings to take as they are (a
     /// heading fit, or an earlier run's kept result).
-    Kept(Vec<Quat>, Option<Vec<Vector3<f64>>>),
+    Kept(Vec<Quat>, Gyros),
+}
+
+/// What a per-sample correction `C(t)` does to the distal IMU's gyros.
+enum GyroUpdate {
+    /// Turned with the sensor frame: `C(t)^-1 w` (the ACM).
+    Turn,
+    /// Replaced by a baseline's own readings (`None`: dropped), since its
+    /// `C(t)` turns with the joint.
+    Replace(Gyros),
 }
 
 /// Fits the heading model of one joint's distal IMU: the window solutions (each
@@ -393,14 +398,7 @@ fn solve_baseline(
     windows: &[Window],
     control: &RunControl,
     progress: &(dyn Fn() + Sync),
-) -> Result<
-    (
-        JointSolution,
-        Option<baselines::BaselineRecord>,
-        BaselineGyro,
-    ),
-    Cancelled,
-> {
+) -> Result<(JointSolution, Option<baselines::BaselineRecord>, Gyros), Cancelled> {
     if control.cancelled() {
         return Err(Cancelled);
     }

@@ -78,6 +78,30 @@ impl Default for HeadingOptions {
 }
 
 impl HeadingOptions {
+    /// Runs a descent through the coarse and the fine phase: `round(stride,
+    /// scan)` does one round on every `stride`-th sample (`scan`: scan the
+    /// whole circle for each heading; the very first round only, when
+    /// `global_scan`) and returns the objective; a phase ends when a round
+    /// gains less than its tolerance or its rounds run out.
+    pub(super) fn run_phases(&self, mut round: impl FnMut(usize, bool) -> f64) {
+        let phases = [
+            (self.coarse_stride, self.coarse_rounds, self.coarse_tol),
+            (self.fine_stride, self.fine_rounds, self.tol),
+        ];
+        let mut first = true;
+        for (stride, max_rounds, tol) in phases {
+            let mut last = f64::INFINITY;
+            for _ in 0..max_rounds {
+                let j = round(stride, self.global_scan && first);
+                first = false;
+                if last - j < tol {
+                    break;
+                }
+                last = j;
+            }
+        }
+    }
+
     /// Plain alternation from zero heading at full resolution, to convergence:
     /// the reference the default solver is tested against.
     pub fn plain_alternation() -> Self {
@@ -199,21 +223,7 @@ impl HeadingProblem<'_> {
             sample_evaluations: 0,
             first_window_start: opts.first_window_start,
         };
-        let phases = [
-            (opts.coarse_stride, opts.coarse_rounds, opts.coarse_tol),
-            (opts.fine_stride, opts.fine_rounds, opts.tol),
-        ];
-        for (stride, max_rounds, tol) in phases {
-            let mut last = f64::INFINITY;
-            for _ in 0..max_rounds {
-                let scan = opts.global_scan && state.rounds == 0;
-                let j = state.round(self, stride, scan, opts.scan_step_deg);
-                if last - j < tol {
-                    break;
-                }
-                last = j;
-            }
-        }
+        opts.run_phases(|stride, scan| state.round(self, stride, scan, opts.scan_step_deg));
         let Alternation {
             c,
             h,

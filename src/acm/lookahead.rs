@@ -113,21 +113,7 @@ impl Lookahead<'_> {
             rounds: 0,
             sample_evaluations: 0,
         };
-        let phases = [
-            (opts.coarse_stride, opts.coarse_rounds, opts.coarse_tol),
-            (opts.fine_stride, opts.fine_rounds, opts.tol),
-        ];
-        for (stride, max_rounds, tol) in phases {
-            let mut last = f64::INFINITY;
-            for _ in 0..max_rounds {
-                let scan = opts.global_scan && s.rounds == 0;
-                let j = self.round(&mut s, stride, scan, opts);
-                if last - j < tol {
-                    break;
-                }
-                last = j;
-            }
-        }
+        opts.run_phases(|stride, scan| self.round(&mut s, stride, scan, opts));
         let window_costs = self.own.window_costs(&s.c, &s.h);
         let window_costs_uncorrected = self.own.window_costs(&Quat::identity(), &vec![0.0; n]);
         HeadingFit {

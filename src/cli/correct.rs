@@ -116,8 +116,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
         &control,
     )?;
     progress.finish();
-    let with_gyros = correction.corrected.imus.iter().any(|i| i.gyro.is_some());
-    if format == TrialFormat::Sto && with_gyros {
+    if format == TrialFormat::Sto && correction.corrected.has_gyros() {
         eprintln!(
             "warning: .sto has no gyroscope columns: the corrected trial's gyroscope readings are not written (--format quat-csv keeps them)"
         );
