@@ -608,6 +608,26 @@ mod tests {
         assert!(one == three, "1 vs 3 threads");
     }
 
+    /// `previous` with the left knee re-corrected against `table`.
+    fn recorrect_l_knee(
+        trial: &Trial,
+        model: &Model,
+        table: &LimitTable,
+        previous: &Correction,
+    ) -> Correction {
+        let settings = Settings::default();
+        recorrect(
+            trial,
+            model,
+            table,
+            &settings,
+            previous,
+            &["l_knee"],
+            &RunControl::default(),
+        )
+        .unwrap()
+    }
+
     /// The knee's table rows narrowed to a flexion range of 20-60 deg.
     fn narrow_l_knee(table: &mut LimitTable) {
         for axis in [0, 2] {
@@ -629,19 +649,9 @@ mod tests {
     #[test]
     fn recorrect_with_a_heading_variant_redoes_the_parent_joint_too() {
         let (trial, model, mut table) = fixture();
-        let settings = Settings::default();
         let full = run_variant(&trial, &model, &table, 2, Variant::DriftHeading);
         narrow_l_knee(&mut table);
-        let edited = recorrect(
-            &trial,
-            &model,
-            &table,
-            &settings,
-            &full,
-            &["l_knee"],
-            &RunControl::default(),
-        )
-        .unwrap();
+        let edited = recorrect_l_knee(&trial, &model, &table, &full);
         // The thigh's fit looks ahead at the knee: the hip changes with it.
         for j in &model.joints {
             let changed = edited.joint(&j.name) != full.joint(&j.name);
@@ -658,31 +668,12 @@ mod tests {
     #[test]
     fn recorrect_redoes_a_joint_and_its_descendants_only() {
         let (trial, model, mut table) = fixture();
-        let settings = Settings::default();
         let full = run_with(&trial, &model, &table, 2);
-        let same = recorrect(
-            &trial,
-            &model,
-            &table,
-            &settings,
-            &full,
-            &["l_knee"],
-            &RunControl::default(),
-        )
-        .unwrap();
+        let same = recorrect_l_knee(&trial, &model, &table, &full);
         assert!(same == full, "recorrect without a change");
         // Narrow the knee's flexion range: knee and ankle change, nothing else.
         narrow_l_knee(&mut table);
-        let edited = recorrect(
-            &trial,
-            &model,
-            &table,
-            &settings,
-            &full,
-            &["l_knee"],
-            &RunControl::default(),
-        )
-        .unwrap();
+        let edited = recorrect_l_knee(&trial, &model, &table, &full);
         for j in &model.joints {
             let changed = edited.joint(&j.name) != full.joint(&j.name);
             assert_eq!(

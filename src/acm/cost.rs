@@ -320,21 +320,25 @@ impl WindowCost {
     }
 }
 
+/// A random rotation of up to `max_deg` degrees about a random axis (tests of
+/// the fast costs against the direct formula).
+#[cfg(test)]
+pub(super) fn random_quat(rng: &mut rand_chacha::ChaCha8Rng, max_deg: f64) -> Quat {
+    use rand::Rng;
+    let axis = [
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    ];
+    crate::rotation::quat_axis_angle_deg(axis, rng.random_range(0.0..max_deg))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::rotation::{quat_axis_angle_deg, quat_from_euler_zyx_deg};
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
-
-    fn random_quat(rng: &mut ChaCha8Rng, max_deg: f64) -> Quat {
-        let axis = [
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        ];
-        quat_axis_angle_deg(axis, rng.random_range(0.0..max_deg))
-    }
 
     #[test]
     fn excursion_formula() {

@@ -139,20 +139,10 @@ impl HeadingCost {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acm::cost::cost_direct;
-    use crate::rotation::quat_axis_angle_deg;
+    use crate::acm::cost::{cost_direct, random_quat};
     use crate::vertical::Vertical;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
-
-    fn random_quat(rng: &mut ChaCha8Rng, max_deg: f64) -> Quat {
-        let axis = [
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        ];
-        quat_axis_angle_deg(axis, rng.random_range(0.0..max_deg))
-    }
 
     fn check(limits: JointLimits, vertical: Vertical) {
         let mut rng = ChaCha8Rng::seed_from_u64(5);

@@ -94,19 +94,9 @@ impl ParentCost {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acm::cost::cost_direct;
-    use crate::rotation::quat_axis_angle_deg;
-    use rand::{Rng, SeedableRng};
+    use crate::acm::cost::{cost_direct, random_quat};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
-
-    fn random_quat(rng: &mut ChaCha8Rng, max_deg: f64) -> Quat {
-        let axis = [
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        ];
-        quat_axis_angle_deg(axis, rng.random_range(0.0..max_deg))
-    }
 
     fn check(limits: JointLimits) {
         let mut rng = ChaCha8Rng::seed_from_u64(8);
