@@ -58,15 +58,17 @@ pub fn run(a: RenderArgs, theme: &str) -> anyhow::Result<i32> {
     let limits_dir = a
         .limits_dir
         .unwrap_or_else(super::common::default_limits_dir);
-    // Read first for a located error and exit code 3 on a malformed table.
-    acm_workbench::limits::LimitsDir::load(&limits_dir)?;
+    // Read here, not by the workbench: a malformed table is a located error
+    // with exit code 3.
+    let read = acm_workbench::limits::LimitsDir::load(&limits_dir)?;
+    let limits = acm_workbench::ui::jobs::limits_state(&limits_dir, read);
     let model = a
         .model
         .as_deref()
         .map(acm_workbench::model::Model::load)
         .transpose()?;
     let label = dir.display().to_string();
-    let mut app = load_app_with(&label, &dir, &limits_dir, model).map_err(|e| anyhow!(e))?;
+    let mut app = load_app_with(&label, &dir, limits, model).map_err(|e| anyhow!(e))?;
     show(
         &mut app,
         &Show {

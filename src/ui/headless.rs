@@ -2,7 +2,7 @@
 //! ratatui `TestBackend`, and turn the buffer into text (optionally with ANSI
 //! SGR colours). `acmw render` and the snapshot tests share this path.
 
-use super::app::{open, update, App, Msg, Overlay, Screen};
+use super::app::{open, update, App, LimitsState, Msg, Overlay, Screen};
 use super::jobs::{list_trials, load_limits, SyncRunner};
 use super::render::render;
 use super::theme::Theme;
@@ -33,18 +33,18 @@ pub const SCREENS: [&str; 12] = [
 
 /// A workbench over `dir` (shown as `dir_label`) with every trial read.
 pub fn load_app(dir_label: &str, dir: &Path, limits_dir: &Path) -> Result<App, String> {
-    load_app_with(dir_label, dir, limits_dir, None)
+    load_app_with(dir_label, dir, load_limits(limits_dir)?, None)
 }
 
-/// As [`load_app`], every trial read with `model` (None: detected per trial).
+/// As [`load_app`], with the limits already read and every trial read with
+/// `model` (None: detected per trial).
 pub fn load_app_with(
     dir_label: &str,
     dir: &Path,
-    limits_dir: &Path,
+    limits: LimitsState,
     model: Option<Model>,
 ) -> Result<App, String> {
     let files = list_trials(dir)?;
-    let limits = load_limits(limits_dir)?;
     let mut app = App::new(dir_label.to_string(), dir.to_path_buf(), files, limits);
     app.model = model.map(std::sync::Arc::new);
     let start = app.start();

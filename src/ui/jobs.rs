@@ -51,13 +51,18 @@ pub fn list_trials(dir: &Path) -> Result<Vec<String>, String> {
 /// saving creates them there. Resolved as the command-line tools do.
 pub fn load_limits(dir: &Path) -> Result<LimitsState, String> {
     let d = LimitsDir::load(dir).map_err(|e| e.to_string())?;
-    Ok(LimitsState::new(
+    Ok(limits_state(dir, d))
+}
+
+/// The limits editor's state of the folder `dir`, read as `d`.
+pub fn limits_state(dir: &Path, d: LimitsDir) -> LimitsState {
+    LimitsState::new(
         dir.to_path_buf(),
         d.settings.table.clone(),
         d.table_source,
         d.table,
         d.settings,
-    ))
+    )
 }
 
 /// Reads the limit files in `dir` as they are on disk now (None if absent or bad).
