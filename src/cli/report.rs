@@ -10,7 +10,11 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct ReportArgs {
-    /// The trial to report on (.csv, .sto, optionally .gz).
+    /// The trial: a canonical CSV (`time,<imu>_qw,_qx,_qy,_qz,...`; `#`
+    /// comment lines above the header), an Euler CSV (`time,<imu>_roll,_pitch,_yaw,...`,
+    /// degrees), an OpenSim `.sto` (each optionally `.gz`); an Xsens MT Manager
+    /// export (`.txt` or `.csv`, tab, comma or semicolon separated: a trial of
+    /// one IMU); a folder of such exports; or an OpenSense mapping `.xml` naming them.
     pub input: PathBuf,
     /// Variants to run and compare (repeatable) [default: all].
     #[arg(long, value_enum)]
