@@ -352,6 +352,9 @@ fn reordered(text: &str) -> String {
     out.join("\n")
 }
 
+/// A rewrite of an export's text.
+type Rewrite = fn(&str) -> String;
+
 #[test]
 fn exports_read_alike_in_any_delimiter_column_order_and_spelling() {
     let dir = tempfile::tempdir().unwrap();
@@ -369,7 +372,7 @@ fn exports_read_alike_in_any_delimiter_column_order_and_spelling() {
             (f, t)
         })
         .collect();
-    let variants: [(&str, fn(&str) -> String); 3] = [
+    let variants: [(&str, Rewrite); 3] = [
         ("comma", |t| with_delimiter(t, ',')),
         ("semicolon", |t| with_delimiter(t, ';')),
         ("reordered", reordered),
