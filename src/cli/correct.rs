@@ -94,7 +94,15 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             args.quiet,
         )?,
     };
-    let (trial, pose) = apply_pose(trial, &ctx.model, pose.as_ref(), &args.input)?;
+    let (mut trial, pose) = apply_pose(trial, &ctx.model, pose.as_ref(), &args.input)?;
+    // Convention checks: mirrored or offset angles against the table.
+    let checks = acm_workbench::pose::convention::check_conventions(
+        &trial,
+        &ctx.model,
+        &ctx.limits,
+        pose.is_some(),
+    );
+    trial.warnings.extend(checks);
     if !args.quiet {
         for w in &trial.warnings {
             eprintln!("warning: {w}");

@@ -94,7 +94,15 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         args.quiet,
     )?;
     let pose_calibration = args.pose.calibration(&ctx.model);
-    let (trial, pose) = apply_pose(trial, &ctx.model, pose_calibration.as_ref(), &args.input)?;
+    let (mut trial, pose) = apply_pose(trial, &ctx.model, pose_calibration.as_ref(), &args.input)?;
+    // Convention checks: mirrored or offset angles against the table.
+    let checks = acm_workbench::pose::convention::check_conventions(
+        &trial,
+        &ctx.model,
+        &ctx.limits,
+        pose.is_some(),
+    );
+    trial.warnings.extend(checks);
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {
             let t = t?;

@@ -324,9 +324,8 @@ fn read_mot(text: &str, origin: &str, model: &Model) -> Result<Reference, TrialE
 fn read_c3d(bytes: &[u8], origin: &str, model: &Model) -> Result<Reference, TrialError> {
     // The parser indexes its input without checking every length; a damaged
     // file becomes an error here, not a crash.
-    let parsed = std::panic::catch_unwind(|| {
-        c3dio::C3d::from_bytes(bytes).map_err(|e| format!("{e:?}"))
-    });
+    let parsed =
+        std::panic::catch_unwind(|| c3dio::C3d::from_bytes(bytes).map_err(|e| format!("{e:?}")));
     let c3d = match parsed {
         Ok(Ok(c)) => c,
         Ok(Err(e)) => {
