@@ -339,9 +339,9 @@ pub fn format_text(r: &ReferenceReport) -> String {
         out,
         "RMS, RMS without offset, offset (deg) and correlation against the reference"
     );
-    let _ = write!(out, "{:<10} {:>5}", "joint", "n");
+    let _ = write!(out, "{:<13} {:>5}", "joint", "n");
     for v in &r.variants {
-        let _ = write!(out, "  {:>26}", v.variant);
+        let _ = write!(out, "  {:>27}", v.variant);
     }
     out.push('\n');
     let axes = r.variants.first().map_or(0, |v| v.axes.len());
@@ -349,7 +349,7 @@ pub fn format_text(r: &ReferenceReport) -> String {
         let a = &r.variants[0].axes[k];
         let _ = write!(
             out,
-            "{:<10} {:>5}",
+            "{:<13} {:>5}",
             format!("{} {}", a.joint, a.axis),
             a.samples
         );
