@@ -160,7 +160,7 @@ impl Trial {
     }
 
     /// Trial length, seconds: `T = n * dt` with dt the median sample interval
-    /// (METHOD.md section 4), or with gaps the span of the times plus one
+    /// (docs/method.md section 7), or with gaps the span of the times plus one
     /// interval ([`timing::trial_length_s`]).
     pub fn duration_s(&self) -> f64 {
         timing::trial_length_s(&self.time_s)
