@@ -324,8 +324,13 @@ fn read_mot(text: &str, origin: &str, model: &Model) -> Result<Reference, TrialE
 fn read_c3d(bytes: &[u8], origin: &str, model: &Model) -> Result<Reference, TrialError> {
     // The parser indexes its input without checking every length; a damaged
     // file becomes an error here, not a crash.
+    // The panic message is not for the user: the hook is silenced meanwhile
+    // and put back after.
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
     let parsed =
         std::panic::catch_unwind(|| c3dio::C3d::from_bytes(bytes).map_err(|e| format!("{e:?}")));
+    std::panic::set_hook(hook);
     let c3d = match parsed {
         Ok(Ok(c)) => c,
         Ok(Err(e)) => {
