@@ -386,6 +386,20 @@ fn exports_read_alike_in_any_delimiter_column_order_and_spelling() {
         assert_eq!(other.imus, tab.imus, "{what}: bit for bit");
         assert_eq!(other.warnings, tab.warnings, "{what}");
     }
+    // Saved as .csv (comma-separated) under the mapping's names: found and read alike.
+    for (f, t) in &originals {
+        std::fs::remove_file(f).unwrap();
+        std::fs::write(f.with_extension("csv"), with_delimiter(t, ',')).unwrap();
+    }
+    let csv = read_trial(&xml, &model).unwrap();
+    assert_eq!(
+        (csv.time_s.clone(), csv.imus.clone()),
+        (tab.time_s.clone(), tab.imus.clone())
+    );
+    for (f, t) in &originals {
+        std::fs::remove_file(f.with_extension("csv")).unwrap();
+        std::fs::write(f, t).unwrap();
+    }
     // A semicolon export says where a bad cell is, naming the separator.
     let (f, t) = &originals[0];
     let bad = with_delimiter(t, ';').replacen("\n00000;", "\n00000", 1);

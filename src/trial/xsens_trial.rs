@@ -107,13 +107,21 @@ fn export_folder(xml: &Path, mapping: &Mapping) -> Option<PathBuf> {
     } else {
         dir
     };
-    let first = format!(
-        "{}{}.txt",
-        mapping.trial_prefix, mapping.sensors[0].file_suffix
-    );
+    let first = format!("{}{}", mapping.trial_prefix, mapping.sensors[0].file_suffix);
     std::iter::once(dir.to_path_buf())
         .chain(sorted_entries(dir).into_iter().filter(|p| p.is_dir()))
-        .find(|d| d.join(&first).is_file())
+        .find(|d| export_in(d, &first).is_file())
+}
+
+/// The export `<stem>.txt` in `dir`, or `<stem>.csv` when only that exists.
+fn export_in(dir: &Path, stem: &str) -> PathBuf {
+    let txt = dir.join(format!("{stem}.txt"));
+    let csv = dir.join(format!("{stem}.csv"));
+    if !txt.is_file() && csv.is_file() {
+        csv
+    } else {
+        txt
+    }
 }
 
 fn files_of_mapping(
@@ -125,7 +133,10 @@ fn files_of_mapping(
         .sensors
         .iter()
         .map(|s| {
-            let f = folder.join(format!("{}{}.txt", mapping.trial_prefix, s.file_suffix));
+            let f = export_in(
+                folder,
+                &format!("{}{}", mapping.trial_prefix, s.file_suffix),
+            );
             if f.is_file() {
                 Ok((f, s.name_in_model.clone()))
             } else {
@@ -181,8 +192,8 @@ fn mapping_for_folder(dir: &Path) -> Option<PathBuf> {
         let Ok(m) = parse_mapping(&text, "") else {
             continue;
         };
-        let first = format!("{}{}.txt", m.trial_prefix, m.sensors[0].file_suffix);
-        if dir.join(first).is_file() {
+        let first = format!("{}{}", m.trial_prefix, m.sensors[0].file_suffix);
+        if export_in(dir, &first).is_file() {
             return Some(xml);
         }
     }
@@ -246,7 +257,11 @@ fn single_export(path: &Path) -> XsensSource {
         .find_map(|xml| {
             let m = parse_mapping(&std::fs::read_to_string(&xml).ok()?, "").ok()?;
             let s = m.sensors.iter().find(|s| {
-                file.as_deref() == Some(&format!("{}{}.txt", m.trial_prefix, s.file_suffix))
+                let stem = format!("{}{}", m.trial_prefix, s.file_suffix);
+                [".txt", ".csv"]
+                    .map(|e| format!("{stem}{e}"))
+                    .iter()
+                    .any(|n| file.as_deref() == Some(n.as_str()))
             })?;
             Some((xml, s.name_in_model.clone(), m))
         });
