@@ -133,6 +133,7 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
         window_s: args.window.unwrap_or(defaults.window_s),
         hop_s: args.hop.unwrap_or(defaults.hop_s),
         vertical: args.vertical.unwrap_or(defaults.vertical),
+        ..defaults
     };
     settings.validate("command line")?;
     Ok(Context {
