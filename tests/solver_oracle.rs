@@ -85,6 +85,38 @@ fn check_trial(name: &str, trial: &Trial, model: &Model, variants: &[Variant], t
     }
 }
 
+/// 20 simulated trials: 14 full bodies (two minutes; every other one with a
+/// heading drift on a calf and a forearm), 3 elbows, 3 knees.
+fn simulated_trials() -> Vec<SimConfig> {
+    use acm_workbench::simulate::{HeadingDrift, KneeAxis, KneeImu};
+    let mut out = Vec::new();
+    for seed in 0..14 {
+        let mut c = SimConfig::full_body(100 + seed);
+        c.duration_s = 120.0;
+        if seed % 2 == 1 {
+            c.drifts = ["l_calf", "r_forearm"]
+                .map(|imu| HeadingDrift {
+                    imu: imu.into(),
+                    start_s: 20.0,
+                    rate_deg_s: 0.1 + 0.02 * seed as f64,
+                })
+                .into();
+        }
+        out.push(c);
+    }
+    for (seed, angle) in [(31, 10.0), (32, 25.0), (33, 40.0)] {
+        out.push(SimConfig::elbow(seed, angle));
+    }
+    for (imu, axis, angle) in [
+        (KneeImu::Calf, KneeAxis::X, 20.0),
+        (KneeImu::Thigh, KneeAxis::Z, 30.0),
+        (KneeImu::Calf, KneeAxis::Z, -12.0),
+    ] {
+        out.push(SimConfig::knee(imu, axis, angle));
+    }
+    out
+}
+
 const VARIANTS: [Variant; 5] = [
     Variant::Basic,
     Variant::Drift,
@@ -113,6 +145,17 @@ fn gradient_solver_is_never_worse_than_nelder_mead() {
         let trial = read_trial(&dir.join(name), &model).unwrap();
         check_trial(name, &trial, &model, &VARIANTS, &mut tally);
     }
+    for (k, config) in simulated_trials().iter().enumerate() {
+        let trial = simulate(config).unwrap().trial;
+        check_trial(
+            &format!("simulated trial {k}"),
+            &trial,
+            &model,
+            &VARIANTS,
+            &mut tally,
+        );
+    }
+    assert!(tally.windows > 1500, "{} windows", tally.windows);
     eprintln!(
         "{} windows: gradient lower on {}, worst relative excess {:e}; evaluations {} vs {}",
         tally.windows, tally.lower, tally.worst_rel, tally.evals_gradient, tally.evals_nm

@@ -257,6 +257,9 @@ pub struct ShapedOptions {
     pub max_step_rad: f64,
     /// A step shorter than this ends a descent, radians.
     pub tol_x_rad: f64,
+    /// Three steps that together gain less than this fraction of the cost
+    /// end a descent.
+    pub tol_f_rel: f64,
     /// A restart that gains less than this ends the search.
     pub min_gain: f64,
     /// Most restarts after the first descent.
@@ -272,9 +275,10 @@ impl Default for ShapedOptions {
         ShapedOptions {
             initial_step_rad: 0.05,
             max_step_rad: 0.5,
-            tol_x_rad: 1e-10,
+            tol_x_rad: 1e-9,
+            tol_f_rel: 1e-10,
             min_gain: 1e-12,
-            max_restarts: 3,
+            max_restarts: 0,
             max_iterations: 200,
             max_line_evals: 40,
         }
@@ -329,24 +333,32 @@ fn quasi_newton(cost: &ShapedCost, base: &Quat, opts: &ShapedOptions) -> (Quat, 
     let mut x = Vector3::zeros();
     let (mut f, mut g) = eval(&x);
     let mut h: Option<Matrix3<f64>> = None;
-    for _ in 0..opts.max_iterations {
+    // Length of the steepest-descent trial step: the first step's, then the
+    // last accepted step's (near a kink the right scale is the recent one).
+    let mut scale = opts.initial_step_rad;
+    let mut gains = [f64::INFINITY; 3];
+    for iteration in 0..opts.max_iterations {
         let gn = g.norm();
         if gn == 0.0 || !gn.is_finite() {
             break;
         }
         let mut d = match &h {
             Some(h) => -(h * g),
-            None => -g * (opts.initial_step_rad / gn),
+            None => -g * (scale / gn),
         };
         if d.dot(&g) >= 0.0 {
             h = None;
-            d = -g * (opts.initial_step_rad / gn);
+            d = -g * (scale / gn);
         }
         let len = d.norm();
         if len > opts.max_step_rad {
             d *= opts.max_step_rad / len;
         }
-        let Some((t, ft, gt)) = wolfe(&mut eval, &x, f, &g, &d, opts.max_line_evals) else {
+        let line = Line {
+            max_evals: opts.max_line_evals,
+            min_step_rad: opts.tol_x_rad,
+        };
+        let Some((t, ft, gt)) = wolfe(&mut eval, (&x, f, &g), &d, &line) else {
             if h.is_some() {
                 // The model misled the step: try once more along the gradient.
                 h = None;
@@ -357,9 +369,10 @@ fn quasi_newton(cost: &ShapedCost, base: &Quat, opts: &ShapedOptions) -> (Quat, 
         let s = d * t;
         let y = gt - g;
         x += s;
-        let gain = f - ft;
+        gains[iteration % 3] = f - ft;
         f = ft;
         g = gt;
+        scale = s.norm().max(opts.tol_x_rad);
         let sy = s.dot(&y);
         if sy > 1e-300 {
             let h0 = h.unwrap_or_else(|| Matrix3::identity() * (sy / y.dot(&y)));
@@ -368,11 +381,19 @@ fn quasi_newton(cost: &ShapedCost, base: &Quat, opts: &ShapedOptions) -> (Quat, 
             let a = i - s * y.transpose() * rho;
             h = Some(a * h0 * a.transpose() + s * s.transpose() * rho);
         }
-        if s.amax() < opts.tol_x_rad || gain <= f.abs() * 1e-16 {
+        let recent: f64 = gains.iter().sum();
+        if s.amax() < opts.tol_x_rad || recent <= opts.tol_f_rel * f.abs() + 1e-15 {
             break;
         }
     }
     (base * quat_from_rotvec(&x), f, evals)
+}
+
+/// Limits of one line search.
+struct Line {
+    max_evals: usize,
+    /// A bracket narrower than this (radians) ends the search.
+    min_step_rad: f64,
 }
 
 /// A weak Wolfe line search along `d` from `x` (value `f`, gradient `g`):
@@ -380,11 +401,9 @@ fn quasi_newton(cost: &ShapedCost, base: &Quat, opts: &ShapedOptions) -> (Quat, 
 /// lowers the cost. Bisects on a bracket, doubles without one.
 fn wolfe(
     eval: &mut impl FnMut(&Vector3<f64>) -> (f64, Vector3<f64>),
-    x: &Vector3<f64>,
-    f: f64,
-    g: &Vector3<f64>,
+    (x, f, g): (&Vector3<f64>, f64, &Vector3<f64>),
     d: &Vector3<f64>,
-    max_evals: usize,
+    line: &Line,
 ) -> Option<(f64, f64, Vector3<f64>)> {
     const C1: f64 = 1e-4;
     const C2: f64 = 0.9;
@@ -392,7 +411,7 @@ fn wolfe(
     let (mut lo, mut hi) = (0.0, f64::INFINITY);
     let mut t = 1.0;
     let mut best: Option<(f64, f64, Vector3<f64>)> = None;
-    for _ in 0..max_evals {
+    for _ in 0..line.max_evals {
         let (ft, gt) = eval(&(x + d * t));
         if ft < f && best.as_ref().is_none_or(|b| ft < b.1) {
             best = Some((t, ft, gt));
@@ -409,7 +428,7 @@ fn wolfe(
         } else {
             2.0 * lo
         };
-        if hi.is_finite() && (hi - lo) * d.amax() < 1e-15 {
+        if hi.is_finite() && (hi - lo) * d.amax() < line.min_step_rad {
             break;
         }
     }
