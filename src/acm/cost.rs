@@ -467,6 +467,9 @@ impl WindowCost {
 
     /// The mean per-sample part of the cost at `c`; with `grad`, its gradient
     /// (see [`WindowCost::data_grad`]) too.
+    // Indexed loops over the parallel arrays of a block: the form the
+    // compiler vectorises.
+    #[allow(clippy::needless_range_loop)]
     fn data(&self, c: &Quat, mut grad: Option<&mut Vector3<f64>>) -> f64 {
         let n = self.samples.len();
         if n == 0 {
