@@ -14,8 +14,8 @@
 //!   cone's tip it steps along the least subgradient, or stops there when that
 //!   is zero (the tip is then a minimum).
 //! - [`minimise`] ([`Solver::NelderMead`]) uses values only: Nelder-Mead, the
-//!   fallback when a gradient search stalls and the oracle the gradient
-//!   solver is tested against.
+//!   previous solver, kept selectable and as the oracle the gradient solver
+//!   is tested against; the heading variants' C steps still use it.
 
 use crate::rotation::{angle_deg, quat_from_rotvec, Quat};
 use nalgebra::{Matrix3, Vector3};
