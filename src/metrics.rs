@@ -1,4 +1,4 @@
-//! The figures a researcher reports (METHOD.md section 6, thesis 4.4-4.6).
+//! The figures a researcher reports (docs/method.md section 16, thesis 4.4-4.6).
 //!
 //! All angles are degrees; joint angles are the Z-Y-X Euler angles of
 //! `(G_R_prox)^T * G_R_dist` taken from whichever trial is given (raw or corrected).

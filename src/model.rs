@@ -1,8 +1,8 @@
-//! Body models as data (METHOD.md section 2): IMUs, joints, correction order, aliases.
+//! Body models as data (docs/method.md section 3): IMUs, joints, correction order, aliases.
 //!
-//! A model is a TOML file. Two ship inside the binary (`infant13`, the source
-//! study's 13-IMU suit, and `opensim`, the OpenSim full-body IMU set); a lab can
-//! point `--model` at its own file. See `models/README.md` for the format.
+//! A model is a TOML file. Four ship inside the binary (`infant13`, the source
+//! study's 13-IMU suit, `opensim`, `opensense_lower` and `full_body16`); a lab can
+//! point `--model` at its own file. The README's "Body models" gives the format.
 
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashSet};
@@ -19,7 +19,7 @@ pub const BUILTIN_MODELS: &[(&str, &str)] = &[
     ("full_body16", include_str!("../models/full_body16.toml")),
 ];
 
-/// An axis of a joint's Z-Y-X Euler angles (METHOD.md section 1).
+/// An axis of a joint's Z-Y-X Euler angles (docs/method.md section 2.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub enum Axis {
     #[serde(rename = "x", alias = "X")]
@@ -139,7 +139,7 @@ impl std::fmt::Display for SignedAxis {
     }
 }
 
-/// How pose calibration finds the subject's heading (METHOD.md section 9).
+/// How pose calibration finds the subject's heading (docs/method.md section 14).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PoseSetup {

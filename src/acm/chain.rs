@@ -1,4 +1,4 @@
-//! Correcting a whole trial down the model's chain (METHOD.md sections 2-4).
+//! Correcting a whole trial down the model's chain (docs/method.md section 8).
 //!
 //! Joints are taken in the model's correction order. Joints at the same depth of
 //! the chain never depend on each other and run in parallel, as do the windows

@@ -1,4 +1,4 @@
-//! The Anatomical Constraint Method (METHOD.md sections 3-4).
+//! The Anatomical Constraint Method (docs/method.md sections 5-10).
 //!
 //! Per joint, the correction C of the distal IMU keeps the joint's Z-Y-X angles
 //! inside their limits (and, with a centroid, near it) at the least rotation.

@@ -1,4 +1,4 @@
-//! `acmw report`: the METHOD.md section 6 figures before and after each variant.
+//! `acmw report`: the figures of docs/method.md section 16 before and after each variant.
 
 use super::common::{apply_pose, load_context, EngineArgs, PoseArgs, Progress};
 use acm_workbench::acm::{RunControl, Variant};

@@ -159,9 +159,9 @@ impl Trial {
         median_dt(&self.time_s)
     }
 
-    /// Trial length, seconds: `T = n * dt` with dt the median sample interval
-    /// (METHOD.md section 4), or with gaps the span of the times plus one
-    /// interval ([`timing::trial_length_s`]).
+    /// Trial length, seconds: the span of the times times `n / (n - 1)` (`n * dt`
+    /// for a regular stream; docs/method.md section 7), or with gaps the span plus
+    /// one median interval ([`timing::trial_length_s`]).
     pub fn duration_s(&self) -> f64 {
         timing::trial_length_s(&self.time_s)
     }
