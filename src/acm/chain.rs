@@ -18,7 +18,9 @@
 use super::cost::WindowCost;
 use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
 use super::lookahead::{ChildJoint, Lookahead};
-use super::minimise::{minimise, MinimiseOptions, Solution};
+use super::minimise::{
+    minimise, minimise_shaped, MinimiseOptions, ShapedCost, ShapedOptions, Solution, Solver,
+};
 use super::window::{correction_series, layout, whole_trial, Window};
 use super::{
     Cancelled, Correction, HeadingWindow, ImuHeading, JointResult, RunControl, SkippedJoint,
@@ -289,8 +291,7 @@ fn run(
                     &trial.time_s,
                     &measured,
                     &windows,
-                    lim,
-                    settings.lambda1,
+                    (lim, settings.lambda1, settings.solver),
                     control,
                     &progress,
                 )?;
@@ -452,28 +453,59 @@ pub fn correct_joint(
     limits: &JointLimits,
     lambda1: f64,
 ) -> JointSolution {
-    solve_windows(
+    correct_joint_with(
         time_s,
         measured,
         windows,
         limits,
         lambda1,
+        Solver::default(),
+    )
+}
+
+/// As [`correct_joint`], with the given minimiser.
+pub fn correct_joint_with(
+    time_s: &[f64],
+    measured: &[Quat],
+    windows: &[Window],
+    limits: &JointLimits,
+    lambda1: f64,
+    solver: Solver,
+) -> JointSolution {
+    solve_windows(
+        time_s,
+        measured,
+        windows,
+        (limits, lambda1, solver),
         &RunControl::default(),
         &|| {},
     )
     .expect("no cancel flag")
 }
 
+/// Minimises one window's cost from `starts` with `solver`.
+pub fn solve_window(cost: &WindowCost, starts: &[Quat], solver: Solver) -> Solution {
+    match solver {
+        Solver::NelderMead => minimise(&|c| cost.eval(c), starts, &MinimiseOptions::default()),
+        Solver::Gradient => {
+            let data = |c: &Quat| cost.data_grad(c);
+            let shaped = ShapedCost {
+                data: &data,
+                cone: cost.lambda1(),
+            };
+            minimise_shaped(&shaped, starts, &ShapedOptions::default())
+        }
+    }
+}
+
 fn solve_windows(
     time_s: &[f64],
     measured: &[Quat],
     windows: &[Window],
-    limits: &JointLimits,
-    lambda1: f64,
+    (limits, lambda1, solver): (&JointLimits, f64, Solver),
     control: &RunControl,
     progress: &(dyn Fn() + Sync),
 ) -> Result<JointSolution, Cancelled> {
-    let opts = MinimiseOptions::default();
     let costs: Vec<WindowCost> = windows
         .iter()
         .map(|w| WindowCost::new(&measured[w.first..w.end], limits, lambda1))
@@ -485,7 +517,7 @@ fn solve_windows(
             if control.cancelled() {
                 return Err(Cancelled);
             }
-            let s = minimise(&|c| cost.eval(c), &[Quat::identity()], &opts);
+            let s = solve_window(cost, &[Quat::identity()], solver);
             progress();
             Ok(s)
         })
@@ -504,7 +536,7 @@ fn solve_windows(
             if neighbours.is_empty() {
                 return first[k];
             }
-            let s = minimise(&|c| cost.eval(c), &neighbours, &opts);
+            let s = solve_window(cost, &neighbours, solver);
             if s.cost < first[k].cost {
                 Solution {
                     evaluations: s.evaluations + first[k].evaluations,

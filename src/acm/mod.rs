@@ -17,7 +17,7 @@ pub mod minimise;
 pub mod parent_cost;
 pub mod window;
 
-pub use chain::{correct_joint, correct_trial, recorrect};
+pub use chain::{correct_joint, correct_joint_with, correct_trial, recorrect, solve_window};
 
 use crate::limits::Settings;
 use crate::trial::Trial;
