@@ -338,7 +338,7 @@ fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
     let mut next_tick: Option<Instant> = None;
     loop {
         // Ticks only while something plays; the debounce and the tick share the wait.
-        next_tick = crate::ui::views::wants_ticks(app)
+        next_tick = crate::ui::app::wants_ticks(app)
             .then(|| next_tick.unwrap_or_else(|| Instant::now() + crate::ui::views::TICK));
         let wake = match (workers.debounce, next_tick) {
             (Some(a), Some(b)) => Some(a.min(b)),

@@ -2,7 +2,13 @@
 //! returns the message that reports its outcome; the runtime calls them on
 //! worker threads, tests call them in line (see [`SyncRunner`]).
 
-use super::app::{update, App, Effect, LimitsState, Loaded, Msg, RunJob};
+pub mod calibration;
+pub mod histogram;
+pub mod pose;
+
+use super::app::{update, App};
+use super::msg::{Effect, Msg, RunJob};
+use super::workbench::{LimitsState, Loaded};
 use crate::acm::{correct_trial, recorrect, Correction, RunControl, Variant};
 use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
@@ -280,32 +286,23 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
             settings_toml,
         } => vec![save_limits(&dir, &table_name, &table_csv, &settings_toml)],
         Effect::Debounce => vec![Msg::RecorrectDue],
-        Effect::Calibrations { dir } => vec![super::calibration::scan(&dir)],
+        Effect::Calibrations { dir } => vec![calibration::scan(&dir)],
         Effect::Histograms {
             trials,
             span,
             table,
-        } => vec![super::histogram::compute_job(&trials, span, &table)],
+        } => vec![histogram::compute_job(&trials, span, &table)],
         Effect::WriteTable {
             path,
             original,
             csv,
-        } => vec![super::histogram::write_job(
-            &path,
-            original.as_deref(),
-            &csv,
-        )],
+        } => vec![histogram::write_job(&path, original.as_deref(), &csv)],
         Effect::PoseCalibrate {
             file,
             loaded,
             calibration,
             limits,
-        } => vec![super::pose::calibrate_job(
-            &file,
-            &loaded,
-            &calibration,
-            &limits,
-        )],
+        } => vec![pose::calibrate_job(&file, &loaded, &calibration, &limits)],
     }
 }
 
