@@ -12,7 +12,7 @@ use super::screens::views::ViewsState;
 use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
 use super::workbench::{AngleCache, LimitsState, LoadState, TrialEntry, VariantResult, Workbench};
 use crate::limits::{LimitTable, SettingsFile};
-use ratatui::crossterm::event::{KeyEvent, KeyEventKind, MouseEventKind};
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseEventKind};
 use std::path::PathBuf;
 
 pub use super::msg::{Effect, Msg, RunJob, Screen};
@@ -159,6 +159,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             vec![]
         }
         Msg::RunDone { file, gen, result } => {
+            let limits_hash = app.limits.table.hash();
             let Some(e) = app.entry_mut(&file) else {
                 return vec![];
             };
@@ -169,11 +170,22 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             match result {
                 Ok((corrections, report)) => {
                     let old = std::mem::take(&mut e.results);
+                    let on_disk = e.loaded().map(|l| l.on_disk.clone()).unwrap_or_default();
                     for c in corrections {
+                        // Saved this session, or by an earlier one with the
+                        // same settings and table.
                         let saved = old
                             .get(&c.variant)
                             .filter(|r| r.correction == c)
-                            .and_then(|r| r.saved.clone());
+                            .and_then(|r| r.saved.clone())
+                            .or_else(|| {
+                                on_disk
+                                    .get(&c.variant)
+                                    .filter(|s| {
+                                        s.settings == c.settings && s.limits_hash == limits_hash
+                                    })
+                                    .map(|s| s.shown.clone())
+                            });
                         e.results.insert(
                             c.variant,
                             VariantResult {
@@ -198,6 +210,9 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             variant,
             result,
         } => {
+            if let Some(e) = app.entry_mut(&file) {
+                e.saving = None;
+            }
             match result {
                 Ok(out) => {
                     if let Some(r) = app
@@ -213,6 +228,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             vec![]
         }
         Msg::LimitsSaved(result) => {
+            app.limits.saving = false;
             match result {
                 Ok(path) => app.info(format!("saved {path}")),
                 Err(m) => {
@@ -226,8 +242,14 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
             vec![]
         }
+        Msg::LimitsInvalid(why) => {
+            app.limits.disk_error = Some(why.clone());
+            app.error(format!("{why} (still using the last good table)"));
+            vec![]
+        }
         Msg::LimitsOnDisk(table, settings) => {
             let l = &mut app.limits;
+            l.disk_error = None;
             if table == l.saved_table && settings == l.saved_settings {
                 return vec![];
             }
@@ -310,12 +332,14 @@ fn recorrect_now(app: &mut App) -> Vec<Effect> {
 }
 
 fn key(app: &mut App, k: KeyEvent) -> Vec<Effect> {
-    // Text entry first: the filter and the cell editor take characters.
-    if app.filter_editing && app.overlay.is_none() {
+    // Text entry first: the filter and the cell editor take characters
+    // (all but Ctrl-C, which quits from anywhere).
+    let quit = k.modifiers.contains(KeyModifiers::CONTROL) && k.code == KeyCode::Char('c');
+    if app.filter_editing && app.overlay.is_none() && !quit {
         trials::filter_key(&mut app.wb, k);
         return vec![];
     }
-    if app.screen == Screen::Limits && app.overlay.is_none() && app.limits.edit.is_some() {
+    if app.screen == Screen::Limits && app.overlay.is_none() && app.limits.edit.is_some() && !quit {
         let reply = limits::edit_key(&mut app.wb, k);
         return follow(app, reply);
     }

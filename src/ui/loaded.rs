@@ -51,4 +51,16 @@ pub struct Loaded {
     pub uncalibrated: Option<Arc<Loaded>>,
     /// Orientation jumps over the default threshold, by time (key `G`).
     pub glitches: Vec<crate::trial::glitch::Glitch>,
+    /// Corrected outputs of this very input found on disk (by their sidecars).
+    pub on_disk: BTreeMap<crate::acm::Variant, SavedOutput>,
+}
+
+/// A corrected output found beside a trial, as its sidecar records it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SavedOutput {
+    /// The output's path relative to the trials folder.
+    pub shown: String,
+    /// The settings and the limit table's hash it was corrected with.
+    pub settings: crate::limits::Settings,
+    pub limits_hash: String,
 }

@@ -29,6 +29,8 @@ pub mod workbench;
 pub use screens::views;
 
 #[cfg(test)]
+mod flows_tests;
+#[cfg(test)]
 mod layers_tests;
 #[cfg(test)]
 mod tests;

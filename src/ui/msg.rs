@@ -129,6 +129,8 @@ pub enum Msg {
     LimitsSaved(Result<String, String>),
     /// The limit files on disk differ from what the workbench last loaded or saved.
     LimitsOnDisk(LimitTable, SettingsFile),
+    /// The limit files on disk cannot be read: why, located (file:line:col).
+    LimitsInvalid(String),
     RecorrectDue,
     /// Time passes (only sent while something plays).
     Tick,

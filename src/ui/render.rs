@@ -69,7 +69,13 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let right = format!(
         "variant {}{} ",
         app.variant,
-        if app.limits.dirty() { "  limits*" } else { "" }
+        if app.limits.disk_error.is_some() {
+            "  limits!"
+        } else if app.limits.dirty() {
+            "  limits*"
+        } else {
+            ""
+        }
     );
     let used: usize = spans.iter().map(|s| s.width()).sum();
     let pad = (area.width as usize).saturating_sub(used + right.len());
@@ -196,12 +202,25 @@ fn quit_confirm(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
             app.limits.table_name
         )));
     }
-    for t in app.trials.iter().filter(|t| t.unsaved_choice()) {
+    if app.limits.saving {
         lines.push(Line::from(format!(
-            "  {} chosen variant {}",
-            t.file,
-            t.chosen.map(|v| v.name()).unwrap_or("")
+            "  limits being saved ({})",
+            app.limits.table_name
         )));
+    }
+    for t in &app.trials {
+        if let Some(v) = t.saving {
+            lines.push(Line::from(format!("  {} {v} being saved", t.file)));
+        } else if t.unsaved_choice() {
+            lines.push(Line::from(format!(
+                "  {} chosen variant {}",
+                t.file,
+                t.chosen.map(|v| v.name()).unwrap_or("")
+            )));
+        }
+        if let Some(pct) = t.running {
+            lines.push(Line::from(format!("  {} correcting, {pct}%", t.file)));
+        }
     }
     lines.push(Line::from(""));
     lines.push(Line::from(vec![

@@ -3,7 +3,7 @@
 //! (open trial, joint, time cursor, variant) and the status message. Screens
 //! read and change it; none of them owns it. No I/O here.
 
-pub use super::loaded::{AngleCache, JointAngles, Loaded};
+pub use super::loaded::{AngleCache, JointAngles, Loaded, SavedOutput};
 use super::msg::{Effect, RunJob};
 use crate::acm::{Correction, Variant};
 use crate::limits::{LimitTable, Settings, SettingsFile};
@@ -49,6 +49,8 @@ pub struct TrialEntry {
     pub report: Option<TrialReport>,
     /// The variant picked on the compare screen.
     pub chosen: Option<Variant>,
+    /// The variant whose save is under way.
+    pub saving: Option<Variant>,
 }
 
 impl TrialEntry {
@@ -62,6 +64,7 @@ impl TrialEntry {
             results: BTreeMap::new(),
             report: None,
             chosen: None,
+            saving: None,
         }
     }
 
@@ -105,8 +108,11 @@ impl TrialEntry {
 
     /// Status of one variant, as the trials and compare screens show it.
     pub fn variant_status(&self, v: Variant) -> String {
+        let on_disk = self.loaded().is_some_and(|l| l.on_disk.contains_key(&v));
         match self.results.get(&v) {
+            _ if self.saving == Some(v) => "saving".into(),
             Some(r) if r.saved.is_some() => "saved".into(),
+            None if on_disk && self.running.is_none() => "saved".into(),
             Some(_) if self.chosen == Some(v) => "chosen".into(),
             _ if self.running.is_some() => format!("{}%", self.running.unwrap_or(0)),
             Some(_) => "done".into(),
@@ -253,6 +259,11 @@ pub struct LimitsState {
     /// Joints edited since the last re-correction (None = settings changed: all).
     pub pending: Option<Vec<String>>,
     pub pending_all: bool,
+    /// A save of the table and settings is under way.
+    pub saving: bool,
+    /// Why the files on disk cannot be read (located); the table in use is
+    /// the last good one.
+    pub disk_error: Option<String>,
 }
 
 /// First editable column of a table row (movement) and the last (lambda2).
@@ -283,6 +294,8 @@ impl LimitsState {
             disk: None,
             pending: None,
             pending_all: false,
+            saving: false,
+            disk_error: None,
         }
     }
 
@@ -488,9 +501,15 @@ impl Workbench {
         self.entry(self.open.as_deref()?)
     }
 
-    /// Whether anything would be lost by quitting now.
+    /// Whether anything would be lost by quitting now: unsaved edits or
+    /// choices, a correction still running, a save still being written.
     pub fn unsaved(&self) -> bool {
-        self.limits.dirty() || self.trials.iter().any(TrialEntry::unsaved_choice)
+        self.limits.dirty()
+            || self.limits.saving
+            || self
+                .trials
+                .iter()
+                .any(|t| t.unsaved_choice() || t.running.is_some() || t.saving.is_some())
     }
 
     /// Sorts the trials by the sort key, keeping the selection.

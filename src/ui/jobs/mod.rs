@@ -8,7 +8,7 @@ pub mod pose;
 
 use super::app::{update, App};
 use super::msg::{Effect, Msg, RunJob};
-use super::workbench::{LimitsState, Loaded};
+use super::workbench::{LimitsState, Loaded, SavedOutput};
 use crate::acm::{correct_trial, recorrect, Correction, RunControl, Variant};
 use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
@@ -72,16 +72,21 @@ pub fn limits_state(dir: &Path, d: LimitsDir) -> LimitsState {
 }
 
 /// Reads the limit files in `dir` as they are on disk now (None if absent or bad).
-pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<(LimitTable, SettingsFile)> {
+pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<Msg> {
     let s = std::fs::read_to_string(dir.join("settings.toml")).ok()?;
-    let settings = SettingsFile::parse(&s, "settings.toml").ok()?;
+    let settings = match SettingsFile::parse(&s, "settings.toml") {
+        Ok(s) => s,
+        Err(e) => return Some(Msg::LimitsInvalid(e.to_string())),
+    };
     let name = if settings.table.is_empty() {
         table_name
     } else {
         &settings.table
     };
-    let table = LimitTable::load(&dir.join(name)).ok()?;
-    Some((table, settings))
+    Some(match LimitTable::load(&dir.join(name)) {
+        Ok(table) => Msg::LimitsOnDisk(table, settings),
+        Err(e) => Msg::LimitsInvalid(e.to_string()),
+    })
 }
 
 /// Reads one trial: the trial, its model, its truth and its uncorrected figures.
@@ -116,7 +121,9 @@ pub fn load_trial(
         };
         let before = trial_figures(&trial, None, truth.as_ref(), &model, limits);
         let glitches = glitches(&trial, glitch_deg);
+        let on_disk = saved_outputs(path, format.output_default(), gzip);
         Ok(Arc::new(Loaded {
+            on_disk,
             glitches,
             trial,
             model,
@@ -131,6 +138,50 @@ pub fn load_trial(
         }))
     })();
     Msg::Loaded(file.to_string(), result)
+}
+
+/// The corrected outputs of `input` on disk whose sidecars record this very
+/// input (by its hash), by variant: what an earlier session saved.
+pub fn saved_outputs(
+    input: &Path,
+    format: crate::trial::TrialFormat,
+    gzip: bool,
+) -> std::collections::BTreeMap<Variant, SavedOutput> {
+    let mut found = std::collections::BTreeMap::new();
+    let mut hash = None;
+    for v in Variant::ALL {
+        let output = default_output(input, v, format, gzip);
+        let side = crate::sidecar::sidecar_path(&output);
+        if !output.is_file() || !side.is_file() {
+            continue;
+        }
+        let Ok(record) = crate::sidecar::Sidecar::load(&side) else {
+            continue;
+        };
+        let hash = hash.get_or_insert_with(|| {
+            crate::trial::input_bytes(input)
+                .map(|b| crate::sidecar::sha256_hex(&b))
+                .unwrap_or_default()
+        });
+        if record.variant != v || record.input.sha256 != *hash {
+            continue;
+        }
+        let shown = input
+            .parent()
+            .and_then(|d| output.strip_prefix(d).ok())
+            .unwrap_or(&output)
+            .display()
+            .to_string();
+        found.insert(
+            v,
+            SavedOutput {
+                shown,
+                settings: record.settings,
+                limits_hash: record.limits.sha256,
+            },
+        );
+    }
+    found
 }
 
 /// Corrects a trial with every variant (or re-corrects the edited joints).

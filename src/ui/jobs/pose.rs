@@ -24,6 +24,8 @@ pub fn calibrate_job(
                 angles: Default::default(),
                 pose: Some(record),
                 uncalibrated: Some(loaded.clone()),
+                // Outputs on disk are of the trial as read.
+                on_disk: Default::default(),
                 ..(**loaded).clone()
             })
         })

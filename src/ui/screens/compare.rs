@@ -192,8 +192,8 @@ pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
         Action::Down => app.joint = (app.joint + 1).min(app.open_joints().len().saturating_sub(1)),
         Action::Run => return app.run_effect(&file, None).into(),
         Action::Choose | Action::Enter => {
+            // The choice is this trial's; the variant shown stays as it is.
             let v = Variant::ALL[*col];
-            app.variant = v;
             if let Some(e) = app.entry_mut(&file) {
                 e.chosen = Some(v);
             }
@@ -214,15 +214,17 @@ pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
                 return Reply::default();
             };
             e.chosen = Some(v);
-            return vec![Effect::SaveVariant {
+            e.saving = Some(v);
+            let effect = Effect::SaveVariant {
                 file: file.clone(),
                 path: e.path.clone(),
                 loaded,
                 correction: r.correction.clone(),
                 limits,
                 limits_source,
-            }]
-            .into();
+            };
+            app.info(format!("saving {file} {v}..."));
+            return vec![effect].into();
         }
         _ => {}
     }

@@ -30,7 +30,7 @@ fn widths(total: usize) -> [usize; 7] {
 pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let l = &app.limits;
     let [head, table, foot] = Layout::vertical([
-        Constraint::Length(1),
+        Constraint::Length(1 + u16::from(l.disk_error.is_some())),
         Constraint::Min(1),
         Constraint::Length(3),
     ])
@@ -40,13 +40,17 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     } else {
         ""
     };
-    f.render_widget(
-        Paragraph::new(Line::from(vec![
-            Span::raw(format!(" {} ", l.source)),
-            Span::styled(dirty, theme.edited),
-        ])),
-        head,
-    );
+    let mut heading = vec![Line::from(vec![
+        Span::raw(format!(" {} ", l.source)),
+        Span::styled(dirty, theme.edited),
+    ])];
+    if let Some(why) = &l.disk_error {
+        heading.push(Line::from(Span::styled(
+            format!(" ! on disk: {why}; in use: the last good table"),
+            theme.error,
+        )));
+    }
+    f.render_widget(Paragraph::new(heading), head);
     let w = widths(table.width as usize);
     let mut lines = vec![];
     let mut h = String::from("  ");
@@ -199,13 +203,15 @@ pub fn action(app: &mut Workbench, from: Screen, a: Action) -> Reply {
             let (table, settings) = (l.table.clone(), l.settings.clone());
             l.saved_table = table.clone();
             l.saved_settings = settings.clone();
-            return vec![Effect::SaveLimits {
+            l.saving = true;
+            let effect = Effect::SaveLimits {
                 dir: l.dir.clone(),
                 table_name: l.table_name.clone(),
                 table_csv: table.to_csv(),
                 settings_toml: settings.to_toml(),
-            }]
-            .into();
+            };
+            app.info(format!("saving {}...", app.limits.table_name));
+            return vec![effect].into();
         }
         _ => {}
     }
