@@ -196,7 +196,11 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                         );
                     }
                     e.report = Some(report);
-                    app.info(format!("{file}: corrections done"));
+                    let shown = app.variant;
+                    match app.entry(&file).and_then(|e| e.variant_note(shown)) {
+                        Some(note) => app.error(format!("{file} {shown}: {note}")),
+                        None => app.info(format!("{file}: corrections done")),
+                    }
                 }
                 Err(m) => app.error(format!("{file}: {m}")),
             }

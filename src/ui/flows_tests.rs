@@ -170,3 +170,47 @@ fn choosing_a_variant_keeps_to_its_trial() {
         .all(|t| t.chosen.is_none()));
     assert_eq!(app.screen, Screen::Compare);
 }
+
+#[test]
+fn what_a_variant_skipped_or_fell_back_to_is_said() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    for f in ["knee.csv", "fb.csv.gz"] {
+        app.select_file(f);
+        keys(&mut app, "r");
+    }
+    let knee = app.entry("knee.csv").unwrap();
+    let fb = app.entry("fb.csv.gz").unwrap();
+    // IK needs the base IMU, which the two-IMU knee trial lacks.
+    let ik = knee.variant_note(Variant::Ik).unwrap();
+    assert_eq!(
+        ik,
+        "nothing corrected: the base IMU 'base' is not in the trial"
+    );
+    assert_eq!(fb.variant_note(Variant::Ik), None);
+    // A baseline corrects only its own joint kind; the rest get drift-centroid.
+    let others = fb.loaded().unwrap().before.len() - 2;
+    let rivest = fb.variant_note(Variant::Rivest).unwrap();
+    assert!(
+        rivest.starts_with(&format!("{others} joint(s) by drift-centroid")),
+        "{rivest}"
+    );
+    // ACM variants do all they were asked.
+    assert!(Variant::ALL
+        .iter()
+        .filter(|v| !matches!(v, Variant::Rivest | Variant::Mueller | Variant::Ik))
+        .all(|&v| fb.variant_note(v).is_none() && knee.variant_note(v).is_none()));
+    // The trial screen's footer says so, the status line says what.
+    app.select_file("knee.csv");
+    key(&mut app, KeyCode::Enter);
+    while app.variant != Variant::Ik {
+        keys(&mut app, "v");
+    }
+    keys(&mut app, "r");
+    let text = buffer_text(terminal(&app, 80, 24).backend().buffer());
+    assert!(text.contains("ik: nothing done!"), "{text}");
+    assert!(
+        text.contains("knee.csv ik: nothing corrected: the base IMU"),
+        "{text}"
+    );
+}

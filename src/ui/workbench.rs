@@ -120,6 +120,71 @@ impl TrialEntry {
         }
     }
 
+    /// What a finished variant left undone or did otherwise than its name
+    /// says: joints it skipped (and why), joints a baseline variant corrected
+    /// with drift-centroid because it has no method for them.
+    pub fn variant_note(&self, v: Variant) -> Option<String> {
+        let c = &self.results.get(&v)?.correction;
+        let corrected = if v == Variant::Ik {
+            c.ik.is_some()
+        } else {
+            !c.joints.is_empty()
+        };
+        // Joints whose IMUs the trial does not have are not the variant's doing.
+        let present: Vec<&str> = self
+            .loaded()
+            .map(|l| l.before.iter().map(|f| f.joint.as_str()).collect())
+            .unwrap_or_default();
+        let skipped: Vec<_> = c
+            .skipped
+            .iter()
+            .filter(|s| present.contains(&s.joint.as_str()))
+            .collect();
+        if !corrected {
+            let why = skipped
+                .first()
+                .map_or("no joint could be corrected", |s| &s.reason);
+            return Some(format!("nothing corrected: {why}"));
+        }
+        let mut notes = vec![];
+        if let Some(s) = skipped.first() {
+            let more = skipped.len() - 1;
+            let more = if more > 0 {
+                format!(" +{more} more")
+            } else {
+                String::new()
+            };
+            notes.push(format!("skipped {} ({}){more}", s.joint, s.reason));
+        }
+        if matches!(v, Variant::Rivest | Variant::Mueller) {
+            let by_acm: Vec<&str> = c
+                .joints
+                .iter()
+                .filter(|j| j.baseline.is_none())
+                .map(|j| j.joint.as_str())
+                .collect();
+            if !by_acm.is_empty() {
+                notes.push(format!(
+                    "{} joint(s) by drift-centroid (no {v} method for them)",
+                    by_acm.len()
+                ));
+            }
+        }
+        (!notes.is_empty()).then(|| notes.join("; "))
+    }
+
+    /// [`TrialEntry::variant_note`] in a few characters, for a footer.
+    pub fn variant_note_short(&self, v: Variant) -> Option<String> {
+        let note = self.variant_note(v)?;
+        Some(if note.starts_with("nothing") {
+            format!("{v}: nothing done!")
+        } else if note.starts_with("skipped") {
+            format!("{v} done, skips!")
+        } else {
+            format!("{v} done, d+c!")
+        })
+    }
+
     /// Whether a chosen variant is not saved yet.
     pub fn unsaved_choice(&self) -> bool {
         self.chosen

@@ -156,8 +156,13 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
             },
         );
     }
+    let note = e
+        .variant_note_short(app.variant)
+        .filter(|_| e.running.is_none());
     let status = if let Some(p) = e.running {
         format!("running {p}%")
+    } else if note.is_some() {
+        String::new()
     } else if e.results.contains_key(&app.variant) {
         format!("{} done", app.variant)
     } else {
@@ -175,6 +180,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
                 theme.warn,
             ),
             Span::styled(status, theme.dim),
+            Span::styled(note.unwrap_or_default(), theme.warn),
             Span::styled(
                 crate::ui::pose::label(l)
                     .map(|p| format!("  {p}"))
