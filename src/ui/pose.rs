@@ -5,6 +5,7 @@
 
 use super::msg::Effect;
 use super::workbench::{LoadState, Loaded, Workbench};
+use crate::pose::convention::check_conventions;
 use crate::pose::{PoseCalibration, PoseTime};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -53,8 +54,13 @@ pub fn calibrated(
     match result {
         Ok(l) => {
             if let Some(p) = &l.pose {
+                let checks = check_conventions(&l.trial, &l.model, &app.limits.table, true);
+                let note = match checks.first() {
+                    Some(w) => format!("; {} convention warning(s), first: {w}", checks.len()),
+                    None => String::new(),
+                };
                 app.info(format!(
-                    "pose calibration at {}: heading corrected by {:.1} deg; P undoes",
+                    "pose calibration at {}: heading corrected by {:.1} deg; P undoes{note}",
                     short(p.calibration.at),
                     p.heading_deg
                 ));

@@ -124,6 +124,10 @@ impl TrialEntry {
     /// says: joints it skipped (and why), joints a baseline variant corrected
     /// with drift-centroid because it has no method for them.
     pub fn variant_note(&self, v: Variant) -> Option<String> {
+        if v == Variant::None {
+            // Leaving the trial as read is what this variant is for.
+            return None;
+        }
         let c = &self.results.get(&v)?.correction;
         let corrected = if v == Variant::Ik {
             c.ik.is_some()

@@ -2,6 +2,7 @@
 
 use crate::limits::LimitTable;
 use crate::metrics::trial_figures;
+use crate::pose::convention::check_conventions;
 use crate::pose::{calibrate, PoseCalibration};
 use crate::ui::msg::Msg;
 use crate::ui::workbench::Loaded;
@@ -16,7 +17,9 @@ pub fn calibrate_job(
     limits: &LimitTable,
 ) -> Msg {
     let result = calibrate(&loaded.trial, &loaded.model, calibration)
-        .map(|(trial, record)| {
+        .map(|(mut trial, record)| {
+            let checks = check_conventions(&trial, &loaded.model, limits, true);
+            trial.warnings.extend(checks);
             let before = trial_figures(&trial, None, loaded.truth.as_ref(), &loaded.model, limits);
             Arc::new(Loaded {
                 trial,
