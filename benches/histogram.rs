@@ -10,7 +10,7 @@ use acm_workbench::simulate::{simulate, SimConfig};
 use acm_workbench::trial::{write_trial, TrialFormat};
 use acm_workbench::ui::app::Msg;
 use acm_workbench::ui::headless::{load_app, show, Show};
-use acm_workbench::ui::histogram::compute_job;
+use acm_workbench::ui::jobs::histogram::compute_job;
 use acm_workbench::ui::render::render;
 use acm_workbench::ui::theme::Theme;
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -1,7 +1,7 @@
 //! Orientation glitches on the trial screen: which belong to the selected
 //! joint, where the next one is (key `G`), and their markers on the charts.
 
-use super::app::Loaded;
+use super::workbench::Loaded;
 use crate::trial::glitch::Glitch;
 
 /// Glitches of the joint's two IMUs (proximal and distal), by time.

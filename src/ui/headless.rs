@@ -2,10 +2,13 @@
 //! ratatui `TestBackend`, and turn the buffer into text (optionally with ANSI
 //! SGR colours). `acmw render` and the snapshot tests share this path.
 
-use super::app::{open, update, App, LimitsState, Msg, Overlay, Screen};
+use super::app::{act, navigate, open, App, Overlay};
 use super::jobs::{list_trials, load_limits, SyncRunner};
+use super::keymap::Action;
+use super::msg::{Nav, Screen};
 use super::render::render;
 use super::theme::Theme;
+use super::workbench::LimitsState;
 use crate::acm::Variant;
 use crate::model::Model;
 use ratatui::backend::TestBackend;
@@ -79,7 +82,7 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
                 .entry(t)
                 .ok_or_else(|| format!("no trial '{t}' in {}", app.dir_label))?;
             if let Some(m) = match &e.load {
-                super::app::LoadState::Failed(m) => Some(m.clone()),
+                super::workbench::LoadState::Failed(m) => Some(m.clone()),
                 _ => None,
             } {
                 if !matches!(s.screen.as_str(), "trials" | "limits" | "help") {
@@ -109,32 +112,27 @@ pub fn show(app: &mut App, s: &Show) -> Result<(), String> {
                     .ok_or_else(|| format!("no joint '{j}' in {t}"))?;
             }
             if app.open_entry().is_some_and(|e| e.results.is_empty()) {
-                let fx = update(
-                    app,
-                    Msg::Key(ratatui::crossterm::event::KeyEvent::from(
-                        ratatui::crossterm::event::KeyCode::Char('r'),
-                    )),
-                );
+                let fx = act(app, Action::Run);
                 SyncRunner::run(app, fx);
             }
             app.message = None;
             if s.screen == "compare" {
                 app.screen = Screen::Compare;
             }
-            if let Some(kind) = super::views::ViewKind::from_name(&s.screen) {
-                super::views::open(app, kind);
+            if let Some(kind) = super::msg::ViewKind::from_name(&s.screen) {
+                navigate(app, Nav::View(kind));
             }
         }
         "limits" => app.screen = Screen::Limits,
         "help" => app.overlay = Some(Overlay::Help),
         "calibration" => {
-            let fx = super::calibration::enter(app);
+            let fx = navigate(app, Nav::Calibration);
             SyncRunner::run(app, fx);
         }
         "histogram" => {
             let t = trial.ok_or("no trial could be read")?;
             open(app, t.clone());
-            let fx = super::histogram::open(app);
+            let fx = navigate(app, Nav::Histogram);
             SyncRunner::run(app, fx);
             if let (Some(j), Some(st)) = (&s.joint, app.histogram.as_mut()) {
                 st.joint = st
@@ -264,6 +262,6 @@ pub fn write_demo_folder(dir: &Path) -> Result<(), String> {
         sim.truth.save_beside(&out).map_err(|e| e.to_string())?;
     }
     std::fs::write(dir.join("broken.csv"), "garbage,1,2\n").map_err(|e| e.to_string())?;
-    super::calibration::write_demo_recordings(dir)?;
+    super::jobs::calibration::write_demo_recordings(dir)?;
     Ok(())
 }

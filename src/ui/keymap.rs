@@ -125,8 +125,12 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "", code: &[KeyCode::Char('n')], action: Action::No, scope: Scope::Everywhere, help: "" },
 ];
 
-/// The action of a key press, if any. Ctrl-combinations are never bound.
+/// The action of a key press, if any. Of the Ctrl-combinations only Ctrl-C
+/// is bound: it quits as `q` does (asking when something would be lost).
 pub fn action(key: &KeyEvent) -> Option<Action> {
+    if key.modifiers.contains(KeyModifiers::CONTROL) && key.code == KeyCode::Char('c') {
+        return Some(Action::Quit);
+    }
     if key.modifiers.contains(KeyModifiers::CONTROL) || key.modifiers.contains(KeyModifiers::ALT) {
         return None;
     }

@@ -1,36 +1,37 @@
 //! The terminal workbench (`acmw` without a subcommand). The only part of the
 //! library that knows ratatui.
 //!
-//! * [`app`]: state, messages and `update(&mut App, Msg) -> Vec<Effect>` (no I/O);
-//! * [`render`] and one module per screen ([`trials`], [`trial`], [`compare`],
-//!   [`limits`]): pure drawing functions of the state;
+//! * [`workbench`]: the data every screen shares (trials, limits, selection),
+//!   and [`loaded`], a trial as read;
+//! * [`msg`]: messages, effects and navigation (a leaf);
+//! * [`screens`]: one module per screen, each with its state, keys and drawing;
+//! * [`app`]: the router, `update(&mut App, Msg) -> Vec<Effect>` (no I/O);
+//! * [`render`]: the frame around the screens (title, status bar, overlays);
 //! * [`jobs`]: the work behind effects, and a synchronous runner for tests;
 //! * [`runtime`]: terminal, event loop, workers, file watching;
-//! * [`headless`]: any screen as text (`acmw render`, snapshot tests);
-//! * [`views`]: the analysis views ([`scatter`], [`globe`], [`applied`], [`stick`]).
+//! * [`headless`]: any screen as text (`acmw render`, snapshot tests).
 
 pub mod app;
-pub mod applied;
-pub mod calibration;
-pub mod compare;
+pub mod cells;
 pub mod glitches;
-pub mod globe;
-pub mod heading;
 pub mod headless;
-pub mod histogram;
 pub mod jobs;
 pub mod keymap;
-pub mod limits;
+pub mod loaded;
+pub mod msg;
 pub mod pose;
 pub mod render;
 pub mod runtime;
-pub mod scatter;
-pub mod stick;
+pub mod screens;
 pub mod theme;
-pub mod trial;
-pub mod trials;
-pub mod views;
+pub mod workbench;
 
+pub use screens::views;
+
+#[cfg(test)]
+mod flows_tests;
+#[cfg(test)]
+mod layers_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

@@ -3,16 +3,15 @@
 //! heading from the base IMU) and re-runs every variant on the calibrated
 //! trial; `P` again goes back to the trial as read.
 
-use super::app::{App, Effect, LoadState, Loaded};
-use crate::limits::LimitTable;
-use crate::metrics::trial_figures;
+use super::msg::Effect;
+use super::workbench::{LoadState, Loaded, Workbench};
 use crate::pose::convention::check_conventions;
-use crate::pose::{calibrate, PoseCalibration, PoseTime};
+use crate::pose::{PoseCalibration, PoseTime};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
 /// `P`: calibrates the open trial at the cursor, or undoes the calibration.
-pub fn toggle(app: &mut App) -> Vec<Effect> {
+pub fn toggle(app: &mut Workbench) -> Vec<Effect> {
     let Some(file) = app.open.clone() else {
         return vec![];
     };
@@ -46,34 +45,12 @@ pub fn toggle(app: &mut App) -> Vec<Effect> {
     }]
 }
 
-/// The work of [`Effect::PoseCalibrate`]: the calibrated trial with its
-/// figures against `limits`.
-pub fn calibrate_job(
-    file: &str,
-    loaded: &Arc<Loaded>,
-    calibration: &PoseCalibration,
-    limits: &LimitTable,
-) -> super::app::Msg {
-    let result = calibrate(&loaded.trial, &loaded.model, calibration)
-        .map(|(mut trial, record)| {
-            let checks = check_conventions(&trial, &loaded.model, limits, true);
-            trial.warnings.extend(checks);
-            let before = trial_figures(&trial, None, loaded.truth.as_ref(), &loaded.model, limits);
-            Arc::new(Loaded {
-                trial,
-                before,
-                angles: Default::default(),
-                pose: Some(record),
-                uncalibrated: Some(loaded.clone()),
-                ..(**loaded).clone()
-            })
-        })
-        .map_err(|e| e.to_string());
-    super::app::Msg::PoseCalibrated(file.to_string(), result)
-}
-
 /// A calibration finished: show the calibrated trial and correct it.
-pub fn calibrated(app: &mut App, file: &str, result: Result<Arc<Loaded>, String>) -> Vec<Effect> {
+pub fn calibrated(
+    app: &mut Workbench,
+    file: &str,
+    result: Result<Arc<Loaded>, String>,
+) -> Vec<Effect> {
     match result {
         Ok(l) => {
             if let Some(p) = &l.pose {
@@ -99,7 +76,7 @@ pub fn calibrated(app: &mut App, file: &str, result: Result<Arc<Loaded>, String>
 
 /// Puts `loaded` in place of the entry's trial, drops the results of the
 /// old one (and any job still running on it) and corrects the new one.
-fn replace(app: &mut App, file: &str, loaded: Arc<Loaded>) -> Vec<Effect> {
+fn replace(app: &mut Workbench, file: &str, loaded: Arc<Loaded>) -> Vec<Effect> {
     let Some(e) = app.entry_mut(file) else {
         return vec![];
     };

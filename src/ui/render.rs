@@ -1,12 +1,13 @@
 //! Drawing: a pure function of the state. One module per screen; this one
 //! draws the frame around them (title, status bar) and the overlays.
 
-use super::app::{App, Overlay, Screen};
+use super::app::{App, Overlay};
+use super::cells::centred;
 use super::keymap::{help_lines, Scope};
+use super::msg::Screen;
+use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
 use super::theme::Theme;
-use super::{compare, limits, trial, trials, views};
 use ratatui::layout::{Constraint, Layout, Rect};
-use ratatui::style::Style;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Clear, Paragraph, Wrap};
 use ratatui::Frame;
@@ -29,13 +30,13 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
     .areas(area);
     title_bar(app, theme, f, top);
     match app.screen {
-        Screen::Trials => trials::render(app, theme, f, body),
-        Screen::Trial => trial::render(app, theme, f, body),
-        Screen::Compare => compare::render(app, theme, f, body),
-        Screen::Limits => limits::render(app, theme, f, body),
-        Screen::Views => views::render(app, theme, f, body),
-        Screen::Calibration => super::calibration::render(app, theme, f, body),
-        Screen::Histogram => super::histogram::render(app, theme, f, body),
+        Screen::Trials => trials::render(&app.wb, theme, f, body),
+        Screen::Trial => trial::render(&app.wb, theme, f, body),
+        Screen::Compare => compare::render(app.compare_col, &app.wb, theme, f, body),
+        Screen::Limits => limits::render(&app.wb, theme, f, body),
+        Screen::Views => views::render(&app.views, &app.wb, theme, f, body),
+        Screen::Calibration => calibration::render(&app.calib, theme, f, body),
+        Screen::Histogram => histogram::render(&app.histogram, &app.wb, theme, f, body),
     }
     status_bar(app, theme, f, bottom);
     match &app.overlay {
@@ -68,7 +69,13 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let right = format!(
         "variant {}{} ",
         app.variant,
-        if app.limits.dirty() { "  limits*" } else { "" }
+        if app.limits.disk_error.is_some() {
+            "  limits!"
+        } else if app.limits.dirty() {
+            "  limits*"
+        } else {
+            ""
+        }
     );
     let used: usize = spans.iter().map(|s| s.width()).sum();
     let pad = (area.width as usize).saturating_sub(used + right.len());
@@ -114,18 +121,6 @@ fn status_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         None => Line::from(Span::raw(format!(" {}", hints(app)))),
     };
     f.render_widget(Paragraph::new(line).style(theme.status), area);
-}
-
-/// A centred rectangle of at most `w` x `h` inside `area`.
-pub fn centred(area: Rect, w: u16, h: u16) -> Rect {
-    let w = w.min(area.width);
-    let h = h.min(area.height);
-    Rect {
-        x: area.x + (area.width - w) / 2,
-        y: area.y + (area.height - h) / 2,
-        width: w,
-        height: h,
-    }
 }
 
 fn popup(f: &mut Frame, theme: &Theme, area: Rect, title: &str, lines: Vec<Line>) {
@@ -207,12 +202,25 @@ fn quit_confirm(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
             app.limits.table_name
         )));
     }
-    for t in app.trials.iter().filter(|t| t.unsaved_choice()) {
+    if app.limits.saving {
         lines.push(Line::from(format!(
-            "  {} chosen variant {}",
-            t.file,
-            t.chosen.map(|v| v.name()).unwrap_or("")
+            "  limits being saved ({})",
+            app.limits.table_name
         )));
+    }
+    for t in &app.trials {
+        if let Some(v) = t.saving {
+            lines.push(Line::from(format!("  {} {v} being saved", t.file)));
+        } else if t.unsaved_choice() {
+            lines.push(Line::from(format!(
+                "  {} chosen variant {}",
+                t.file,
+                t.chosen.map(|v| v.name()).unwrap_or("")
+            )));
+        }
+        if let Some(pct) = t.running {
+            lines.push(Line::from(format!("  {} correcting, {pct}%", t.file)));
+        }
     }
     lines.push(Line::from(""));
     lines.push(Line::from(vec![
@@ -247,35 +255,4 @@ fn reload_conflict(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
         "Limits changed on disk",
         lines,
     );
-}
-
-/// `value` with one decimal, or `-`.
-pub fn num(v: Option<f64>, width: usize) -> String {
-    match v {
-        Some(v) if v.is_finite() => format!("{v:>width$.1}"),
-        _ => format!("{:>width$}", "-"),
-    }
-}
-
-/// Cuts `s` to `w` characters (with `~` when cut).
-pub fn fit(s: &str, w: usize) -> String {
-    let n = s.chars().count();
-    if n <= w {
-        format!("{s:<w$}")
-    } else if w == 0 {
-        String::new()
-    } else {
-        let mut t: String = s.chars().take(w - 1).collect();
-        t.push('~');
-        t
-    }
-}
-
-/// A style for selected rows.
-pub fn sel(theme: &Theme, selected: bool) -> Style {
-    if selected {
-        theme.selected
-    } else {
-        Style::default()
-    }
 }

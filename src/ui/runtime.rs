@@ -205,12 +205,13 @@ fn watch_trials(dir: &Path, poll: Option<Duration>, tx: Sender<Event>) -> Option
             .collect();
         for name in names {
             let path = d.join(&name);
-            let msg = if is_trial_path(&path) {
-                Msg::FileChanged(name, path)
-            } else if path.exists() {
-                continue;
-            } else {
+            // A deleted trial leaves the list, whatever its name says.
+            let msg = if !path.exists() {
                 Msg::FileRemoved(name)
+            } else if is_trial_path(&path) {
+                Msg::FileChanged(name, path)
+            } else {
+                continue;
             };
             let _ = tx.send(Event::Msg(msg));
         }
@@ -234,8 +235,8 @@ fn watch_limits(
                 .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
         });
         if relevant {
-            if let Some((t, s)) = read_limits_on_disk(&d, &table) {
-                let _ = tx.send(Event::Msg(Msg::LimitsOnDisk(t, s)));
+            if let Some(msg) = read_limits_on_disk(&d, &table) {
+                let _ = tx.send(Event::Msg(msg));
             }
         }
     })
@@ -338,7 +339,7 @@ fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
     let mut next_tick: Option<Instant> = None;
     loop {
         // Ticks only while something plays; the debounce and the tick share the wait.
-        next_tick = crate::ui::views::wants_ticks(app)
+        next_tick = crate::ui::app::wants_ticks(app)
             .then(|| next_tick.unwrap_or_else(|| Instant::now() + crate::ui::views::TICK));
         let wake = match (workers.debounce, next_tick) {
             (Some(a), Some(b)) => Some(a.min(b)),
@@ -471,5 +472,30 @@ mod tests {
         std::thread::sleep(Duration::from_millis(1100));
         crate::save::atomic_write(&file, b"time,x\n").unwrap();
         arrives("an atomic save over it");
+    }
+
+    #[test]
+    fn a_deleted_trial_is_reported_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("t.csv");
+        std::fs::write(&file, "time\n").unwrap();
+        let (tx, rx) = unbounded();
+        let _w = watch_trials(dir.path(), Some(Duration::from_millis(50)), tx)
+            .expect("a poll watcher starts on any folder");
+        std::fs::remove_file(&file).unwrap();
+        // The deadline only keeps a broken watcher from hanging the suite.
+        loop {
+            match rx.recv_timeout(Duration::from_secs(20)) {
+                Ok(Event::Msg(Msg::FileRemoved(name))) => {
+                    assert_eq!(name, "t.csv");
+                    break;
+                }
+                Ok(Event::Msg(Msg::FileChanged(name, _))) => {
+                    panic!("{name} was deleted, not changed")
+                }
+                Ok(_) => {}
+                Err(_) => panic!("no removal seen"),
+            }
+        }
     }
 }

@@ -2,9 +2,10 @@
 //! and a no-panic test at tiny sizes. Background work runs through
 //! [`SyncRunner`]; nothing sleeps.
 
-use super::app::{update, App, Msg, Overlay, Screen};
+use super::app::{update, App, Msg, Overlay};
 use super::headless::{draw, load_app, show, write_demo_folder, Show, SCREENS};
 use super::jobs::SyncRunner;
+use super::msg::Screen;
 use super::render::render;
 use super::theme::Theme;
 use crate::acm::Variant;
@@ -94,7 +95,7 @@ fn trials_states() {
     // A load error row is part of the list.
     assert!(app.trials.iter().any(|t| matches!(
         &t.load,
-        super::app::LoadState::Failed(m) if m.starts_with("broken.csv:")
+        super::workbench::LoadState::Failed(m) if m.starts_with("broken.csv:")
     )));
     // A run in progress at a fixed percentage.
     app.select_file("knee.csv");

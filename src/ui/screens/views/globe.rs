@@ -4,10 +4,9 @@
 //! points coloured by limit class over all three axes (rotation, which cannot
 //! move a point, shows only in its colour), or by time with `t`.
 
-use super::app::{App, TrialEntry};
 use super::scatter::{colouring, legend_of};
-use super::theme::Theme;
-use super::views::{
+use super::Ctx;
+use super::{
     colour, joint_data, marker, resolution, square_around, RasterShape, BAND_COLOUR, CLASS_COLOURS,
     TIME_COLOURS,
 };
@@ -15,6 +14,8 @@ use crate::analysis::globe::{
     band_outline, band_raster, extent, globe_raster, grid_lines, rect_outline, GlobeView, JointAxes,
 };
 use crate::analysis::scatter::{Colouring, Grid};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::TrialEntry;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Color;
 use ratatui::text::{Line, Span};
@@ -52,7 +53,7 @@ fn draw_runs(ctx: &mut Context, runs: &[Vec<(f64, f64)>], color: Color) {
     }
 }
 
-pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(d) = joint_data(app, e) else {
         f.render_widget(
             Paragraph::new("no joint with both IMUs in this trial"),

@@ -1,59 +1,29 @@
 //! The analysis views of the open trial: 3-D scatter projections
-//! ([`super::scatter`], key `x`), the globographic plot ([`super::globe`], `o`),
-//! the applied correction over time ([`super::applied`], `a`) and the stick
-//! figure ([`super::stick`], `f`), and the heading drift per IMU
-//! ([`super::heading`], `D`). This module holds their state, their keys
+//! ([`scatter`], key `x`), the globographic plot ([`globe`], `o`),
+//! the applied correction over time ([`applied`], `a`) and the stick
+//! figure ([`stick`], `f`), and the heading drift per IMU
+//! ([`heading`], `D`). This module holds their state, their keys
 //! and what they share; the numbers come from [`crate::analysis`].
 
-use super::app::{App, JointAngles, Screen, TrialEntry};
-use super::keymap::Action;
-use super::theme::Theme;
+pub mod applied;
+pub mod globe;
+pub mod heading;
+pub mod scatter;
+pub mod stick;
+
 use crate::analysis::scatter::Raster;
 use crate::model::Joint;
+use crate::ui::keymap::Action;
+pub use crate::ui::msg::ViewKind;
+use crate::ui::msg::{Nav, Reply, Screen};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::{JointAngles, TrialEntry, Workbench};
 use ratatui::layout::Rect;
 use ratatui::style::Color;
 use ratatui::symbols::Marker;
 use ratatui::widgets::canvas::{Painter, Shape};
 use ratatui::widgets::Paragraph;
 use ratatui::Frame;
-
-/// Which view is in front.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ViewKind {
-    #[default]
-    Scatter,
-    Globe,
-    Applied,
-    Stick,
-    /// The heading drift per IMU of a heading variant ([`super::heading`]).
-    Heading,
-}
-
-impl ViewKind {
-    /// The view's name in titles and `acmw render`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ViewKind::Scatter => "scatter",
-            ViewKind::Globe => "globe",
-            ViewKind::Applied => "applied",
-            ViewKind::Stick => "stick",
-            ViewKind::Heading => "heading",
-        }
-    }
-
-    /// The view of a name.
-    pub fn from_name(name: &str) -> Option<ViewKind> {
-        [
-            ViewKind::Scatter,
-            ViewKind::Globe,
-            ViewKind::Applied,
-            ViewKind::Stick,
-            ViewKind::Heading,
-        ]
-        .into_iter()
-        .find(|k| k.name() == name)
-    }
-}
 
 /// State of the analysis views.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -73,26 +43,37 @@ pub const PLAY_STEP_S: f64 = 0.1;
 pub const TICK: std::time::Duration = std::time::Duration::from_millis(100);
 
 /// Opens a view from the trial screen.
-pub fn open(app: &mut App, kind: ViewKind) {
-    if app.screen != Screen::Views {
-        app.views.time_s = app.view.cursor_s;
+pub fn open(st: &mut ViewsState, app: &Workbench, kind: ViewKind, from_views: bool) {
+    if !from_views {
+        st.time_s = app.view.cursor_s;
     }
-    app.views.kind = kind;
-    app.views.playing = false;
-    app.screen = Screen::Views;
+    st.kind = kind;
+    st.playing = false;
 }
 
-fn duration(app: &App) -> f64 {
+/// What a view draws from: the shared data and the views' own state.
+pub struct Ctx<'a> {
+    pub wb: &'a Workbench,
+    pub views: &'a ViewsState,
+}
+
+impl std::ops::Deref for Ctx<'_> {
+    type Target = Workbench;
+    fn deref(&self) -> &Workbench {
+        self.wb
+    }
+}
+
+fn duration(app: &Workbench) -> f64 {
     app.open_entry()
         .and_then(|e| e.loaded())
         .map_or(0.0, |l| l.trial.duration_s())
 }
 
 /// What a key does on a view.
-pub fn action(app: &mut App, a: Action) {
+pub fn action(v: &mut ViewsState, app: &mut Workbench, a: Action) -> Reply {
     let d = duration(app);
     let joints = app.open_joints().len();
-    let v = &mut app.views;
     let scrub = |v: &mut ViewsState, by: f64| {
         v.time_s = (v.time_s + by).clamp(0.0, d);
         v.playing = false;
@@ -101,17 +82,17 @@ pub fn action(app: &mut App, a: Action) {
         Action::Back => {
             v.playing = false;
             app.view.cursor_s = v.time_s.clamp(0.0, d);
-            app.screen = Screen::Trial;
+            return Reply::nav(Nav::To(Screen::Trial));
         }
-        Action::Scatter => open(app, ViewKind::Scatter),
-        Action::Globe => open(app, ViewKind::Globe),
-        Action::Applied => open(app, ViewKind::Applied),
-        Action::Stick => open(app, ViewKind::Stick),
-        Action::HeadingDrift => open(app, ViewKind::Heading),
+        Action::Scatter => return Reply::nav(Nav::View(ViewKind::Scatter)),
+        Action::Globe => return Reply::nav(Nav::View(ViewKind::Globe)),
+        Action::Applied => return Reply::nav(Nav::View(ViewKind::Applied)),
+        Action::Stick => return Reply::nav(Nav::View(ViewKind::Stick)),
+        Action::HeadingDrift => return Reply::nav(Nav::View(ViewKind::Heading)),
         Action::TimeColour => v.time_colour = !v.time_colour,
         Action::Up => app.joint = app.joint.saturating_sub(1),
         Action::Down => app.joint = (app.joint + 1).min(joints.saturating_sub(1)),
-        Action::Variant => super::app::next_variant(app),
+        Action::Variant => app.next_variant(),
         Action::Marker => app.view.braille = !app.view.braille,
         Action::Left | Action::CursorLeft => scrub(v, -1.0),
         Action::Right | Action::CursorRight => scrub(v, 1.0),
@@ -127,16 +108,16 @@ pub fn action(app: &mut App, a: Action) {
         }
         _ => {}
     }
+    Reply::default()
 }
 
 /// Advances a playing stick figure; stops at the end of the trial.
-pub fn tick(app: &mut App) {
-    if app.screen != Screen::Views || !app.views.playing {
-        app.views.playing = false;
+pub fn tick(v: &mut ViewsState, app: &Workbench, in_front: bool) {
+    if !in_front || !v.playing {
+        v.playing = false;
         return;
     }
     let d = duration(app);
-    let v = &mut app.views;
     v.time_s = (v.time_s + PLAY_STEP_S).min(d);
     if v.time_s >= d {
         v.playing = false;
@@ -144,12 +125,13 @@ pub fn tick(app: &mut App) {
 }
 
 /// Whether the runtime should send ticks.
-pub fn wants_ticks(app: &App) -> bool {
-    app.screen == Screen::Views && app.views.playing
+pub fn wants_ticks(v: &ViewsState) -> bool {
+    v.playing
 }
 
 /// Draws the view in front.
-pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(views: &ViewsState, wb: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
+    let app = &Ctx { wb, views };
     let Some(e) = app.open_entry() else {
         f.render_widget(Paragraph::new("no trial open (Esc)"), area);
         return;
@@ -159,11 +141,11 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         return;
     }
     match app.views.kind {
-        ViewKind::Scatter => super::scatter::render(app, e, theme, f, area),
-        ViewKind::Globe => super::globe::render(app, e, theme, f, area),
-        ViewKind::Applied => super::applied::render(app, e, theme, f, area),
-        ViewKind::Stick => super::stick::render(app, e, theme, f, area),
-        ViewKind::Heading => super::heading::render(app, e, theme, f, area),
+        ViewKind::Scatter => scatter::render(app, e, theme, f, area),
+        ViewKind::Globe => globe::render(app, e, theme, f, area),
+        ViewKind::Applied => applied::render(app, e, theme, f, area),
+        ViewKind::Stick => stick::render(app, e, theme, f, area),
+        ViewKind::Heading => heading::render(app, e, theme, f, area),
     }
 }
 
@@ -176,7 +158,7 @@ pub struct JointData<'a> {
 }
 
 /// The joint the views show (the trial screen's selection).
-pub fn joint_data<'a>(app: &App, e: &'a TrialEntry) -> Option<JointData<'a>> {
+pub fn joint_data<'a>(app: &Workbench, e: &'a TrialEntry) -> Option<JointData<'a>> {
     let l = e.loaded()?;
     let name = l.before.get(app.joint)?.joint.clone();
     let joint = l.model.joint(&name)?;
@@ -212,7 +194,7 @@ pub fn colour(theme: &Theme, c: Color) -> Color {
 }
 
 /// The canvas marker of the views (`m` switches braille / dots).
-pub fn marker(app: &App) -> Marker {
+pub fn marker(app: &Workbench) -> Marker {
     if app.view.braille {
         Marker::Braille
     } else {

@@ -10,22 +10,21 @@
 //! The trials are the open one (from the trial screen) or every loaded trial
 //! the trials screen shows (filter with `/` first to choose).
 
-use super::app::{App, Effect, Loaded, Msg, Screen};
-use super::keymap::Action;
-use super::render::{centred, fit, sel};
-use super::theme::Theme;
-use crate::analysis::centroid::{centroids, CentroidTable};
-use crate::analysis::histogram::{histograms, AxisHistogram, JointHistogram, DEFAULT_BIN_DEG};
-use crate::analysis::suggest::{same_file, suggest_limits, SuggestOptions, Suggestion, WriteError};
-use crate::analysis::{pool_by_joint, pool_by_table_row, TimeSpan, TrialRef};
+use crate::analysis::histogram::{AxisHistogram, JointHistogram};
+use crate::analysis::suggest::{suggest_limits, SuggestOptions, Suggestion};
+use crate::analysis::TimeSpan;
 use crate::limits::axis_name;
-use crate::limits::LimitTable;
+use crate::ui::cells::{centred, fit, sel};
+use crate::ui::keymap::Action;
+use crate::ui::msg::{Computed, Effect, Nav, Reply, RowAnalysis, Screen};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::Workbench;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Borders, Chart, Clear, Dataset, GraphType, Paragraph};
 use ratatui::Frame;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 /// Shortest span the `-` key narrows to, seconds.
@@ -57,8 +56,8 @@ pub struct HistogramState {
 }
 
 /// Opens the screen over the trials the current screen has chosen.
-pub fn open(app: &mut App) -> Vec<Effect> {
-    let files: Vec<String> = match app.screen {
+pub fn open(hist: &mut Option<HistogramState>, app: &mut Workbench, from: Screen) -> Vec<Effect> {
+    let files: Vec<String> = match from {
         Screen::Trial | Screen::Compare => app.open.clone().into_iter().collect(),
         _ => app
             .visible()
@@ -72,8 +71,8 @@ pub fn open(app: &mut App) -> Vec<Effect> {
         return vec![];
     }
     let effect = request(app, &files, TimeSpan::FIRST_30_S);
-    app.histogram = Some(HistogramState {
-        from: app.screen,
+    *hist = Some(HistogramState {
+        from,
         files,
         span: TimeSpan::FIRST_30_S,
         hists: vec![],
@@ -84,12 +83,11 @@ pub fn open(app: &mut App) -> Vec<Effect> {
         suggestion: None,
         scroll: 0,
     });
-    app.screen = Screen::Histogram;
     vec![effect]
 }
 
 /// The background job computing the histograms of `files` over `span`.
-fn request(app: &App, files: &[String], span: TimeSpan) -> Effect {
+fn request(app: &Workbench, files: &[String], span: TimeSpan) -> Effect {
     Effect::Histograms {
         trials: files
             .iter()
@@ -100,61 +98,14 @@ fn request(app: &App, files: &[String], span: TimeSpan) -> Effect {
     }
 }
 
-/// What the histogram job computes over one span.
-#[derive(Debug, Clone)]
-pub struct Computed {
-    pub span: TimeSpan,
-    /// One histogram per joint, in model order.
-    pub joints: Vec<JointHistogram>,
-    pub rows: Arc<RowAnalysis>,
-}
-
-/// The span's samples pooled per row of `table` (joints sharing a row pool
-/// together): the histograms a suggestion is made from, and the centroids.
-#[derive(Debug, Clone)]
-pub struct RowAnalysis {
-    /// The table the rows are of (a suggestion needs the same one).
-    pub table: LimitTable,
-    pub hists: Vec<JointHistogram>,
-    pub centroids: CentroidTable,
-}
-
-/// Histograms (per joint and per table row) and centroids of loaded trials
-/// over `span` (in a worker thread).
-pub fn compute_job(trials: &[Arc<Loaded>], span: TimeSpan, table: &LimitTable) -> Msg {
-    let refs: Vec<TrialRef> = trials
-        .iter()
-        .map(|l| TrialRef {
-            trial: &l.trial,
-            model: &l.model,
-        })
-        .collect();
-    let (joints, hists, centroid_table) = match refs.first() {
-        None => (vec![], vec![], centroids(&[], span)),
-        Some(r) => {
-            let by_row = pool_by_table_row(&refs, span, table);
-            (
-                histograms(&pool_by_joint(&refs, span), table, r.model, DEFAULT_BIN_DEG),
-                histograms(&by_row, table, r.model, DEFAULT_BIN_DEG),
-                centroids(&by_row, span),
-            )
-        }
-    };
-    Msg::Histograms(Box::new(Computed {
-        span,
-        joints,
-        rows: Arc::new(RowAnalysis {
-            table: table.clone(),
-            hists,
-            centroids: centroid_table,
-        }),
-    }))
-}
-
 /// Takes the results of the span the screen last asked for (dropping those of
 /// spans it has moved past), then does a suggestion or save asked for meanwhile.
-pub fn received(app: &mut App, c: Computed) -> Vec<Effect> {
-    let Some(st) = app.histogram.as_mut().filter(|st| st.span == c.span) else {
+pub fn received(
+    hist: &mut Option<HistogramState>,
+    app: &mut Workbench,
+    c: Computed,
+) -> Vec<Effect> {
+    let Some(st) = hist.as_mut().filter(|st| st.span == c.span) else {
         return vec![];
     };
     st.hists = c.joints;
@@ -162,17 +113,21 @@ pub fn received(app: &mut App, c: Computed) -> Vec<Effect> {
     st.computing = false;
     st.joint = st.joint.min(st.hists.len().saturating_sub(1));
     match st.pending.take() {
-        Some(Action::Enter) => suggest(app),
-        Some(Action::Save) => save_centroids(app),
+        Some(Action::Enter) => suggest(hist, app),
+        Some(Action::Save) => save_centroids(hist, app),
         _ => vec![],
     }
 }
 
 /// The row analysis of the current span against the current table; else
 /// `then` is remembered for when it arrives (asking for it if the table changed).
-fn ready_rows(app: &mut App, then: Action) -> Result<Arc<RowAnalysis>, Vec<Effect>> {
+fn ready_rows(
+    hist: &mut Option<HistogramState>,
+    app: &mut Workbench,
+    then: Action,
+) -> Result<Arc<RowAnalysis>, Vec<Effect>> {
     let table = &app.limits.table;
-    let Some(st) = app.histogram.as_mut() else {
+    let Some(st) = hist.as_mut() else {
         return Err(vec![]);
     };
     match &st.rows {
@@ -191,25 +146,24 @@ fn ready_rows(app: &mut App, then: Action) -> Result<Arc<RowAnalysis>, Vec<Effec
 }
 
 /// The suggested table's file: `<table stem>.suggested.csv` beside the table.
-pub fn suggested_path(app: &App) -> PathBuf {
+pub fn suggested_path(app: &Workbench) -> PathBuf {
     let name = &app.limits.table_name;
     let stem = name.strip_suffix(".csv").unwrap_or(name);
     app.limits.dir.join(format!("{stem}.suggested.csv"))
 }
 
 /// The centroid table's file, beside the limit tables.
-pub fn centroids_path(app: &App) -> PathBuf {
+pub fn centroids_path(app: &Workbench) -> PathBuf {
     app.limits.dir.join("centroids.csv")
 }
 
 /// Applies a key on the histogram screen.
-pub fn action(app: &mut App, a: Action) -> Vec<Effect> {
-    let Some(st) = app.histogram.as_mut() else {
-        app.screen = Screen::Trials;
-        return vec![];
+pub fn action(hist: &mut Option<HistogramState>, app: &mut Workbench, a: Action) -> Reply {
+    let Some(st) = hist.as_mut() else {
+        return Reply::nav(Nav::To(Screen::Trials));
     };
     if let Some(s) = st.suggestion.clone() {
-        return confirm(app, &s, a);
+        return confirm(hist, app, &s, a).into();
     }
     let mut span = st.span;
     let len = if span.end_s.is_finite() {
@@ -218,10 +172,7 @@ pub fn action(app: &mut App, a: Action) -> Vec<Effect> {
         f64::INFINITY
     };
     match a {
-        Action::Back => {
-            app.screen = st.from;
-            return vec![];
-        }
+        Action::Back => return Reply::nav(Nav::To(st.from)),
         Action::Up => st.joint = st.joint.saturating_sub(1),
         Action::Down => st.joint = (st.joint + 1).min(st.hists.len().saturating_sub(1)),
         Action::Left if len.is_finite() => {
@@ -238,26 +189,26 @@ pub fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Action::ZoomOut if len.is_finite() => span.end_s = span.start_s + 2.0 * len,
         Action::Home => span = TimeSpan::FIRST_30_S,
         Action::End => span = TimeSpan::WHOLE,
-        Action::Enter => return suggest(app),
-        Action::Save => return save_centroids(app),
+        Action::Enter => return suggest(hist, app).into(),
+        Action::Save => return save_centroids(hist, app).into(),
         _ => {}
     }
     if span != st.span {
         st.span = span;
         st.computing = true;
         let files = st.files.clone();
-        return vec![request(app, &files, span)];
+        return vec![request(app, &files, span)].into();
     }
-    vec![]
+    Reply::default()
 }
 
 /// The suggestion from the chosen trials' intervals, pooled per table row.
-fn suggest(app: &mut App) -> Vec<Effect> {
-    let rows = match ready_rows(app, Action::Enter) {
+fn suggest(hist: &mut Option<HistogramState>, app: &mut Workbench) -> Vec<Effect> {
+    let rows = match ready_rows(hist, app, Action::Enter) {
         Ok(r) => r,
         Err(fx) => return fx,
     };
-    let Some(st) = app.histogram.as_mut() else {
+    let Some(st) = hist.as_mut() else {
         return vec![];
     };
     let s = suggest_limits(&rows.table, &rows.hists, st.span, SuggestOptions::default());
@@ -269,10 +220,15 @@ fn suggest(app: &mut App) -> Vec<Effect> {
 }
 
 /// Keys while the diff is shown: y saves, n or Esc cancels, arrows scroll.
-fn confirm(app: &mut App, s: &Suggestion, a: Action) -> Vec<Effect> {
+fn confirm(
+    hist: &mut Option<HistogramState>,
+    app: &Workbench,
+    s: &Suggestion,
+    a: Action,
+) -> Vec<Effect> {
     let path = suggested_path(app);
     let original = app.limits.dir.join(&app.limits.table_name);
-    let Some(st) = app.histogram.as_mut() else {
+    let Some(st) = hist.as_mut() else {
         return vec![];
     };
     match a {
@@ -292,8 +248,8 @@ fn confirm(app: &mut App, s: &Suggestion, a: Action) -> Vec<Effect> {
     vec![]
 }
 
-fn save_centroids(app: &mut App) -> Vec<Effect> {
-    let rows = match ready_rows(app, Action::Save) {
+fn save_centroids(hist: &mut Option<HistogramState>, app: &mut Workbench) -> Vec<Effect> {
+    let rows = match ready_rows(hist, app, Action::Save) {
         Ok(r) => r,
         Err(fx) => return fx,
     };
@@ -304,25 +260,8 @@ fn save_centroids(app: &mut App) -> Vec<Effect> {
     }]
 }
 
-/// Writes a table (the work behind [`Effect::WriteTable`]): creates the
-/// folder, saves atomically keeping `.bak`, never over `original`.
-pub fn write_job(path: &Path, original: Option<&Path>, csv: &str) -> Msg {
-    let result = (|| {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        }
-        if let Some(orig) = original.filter(|o| same_file(path, o)) {
-            return Err(WriteError::Original(orig.to_path_buf()).to_string());
-        }
-        crate::save::atomic_write(path, csv.as_bytes())
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok(path.display().to_string())
-    })();
-    Msg::TableWritten(result)
-}
-
 /// Reports a finished write in the status bar.
-pub fn written(app: &mut App, result: Result<String, String>) {
+pub fn written(app: &mut Workbench, result: Result<String, String>) {
     app.message = Some(match result {
         Ok(p) => (format!("saved {p}"), false),
         Err(m) => (format!("cannot save: {m}"), true),
@@ -330,8 +269,14 @@ pub fn written(app: &mut App, result: Result<String, String>) {
 }
 
 /// Draws the screen.
-pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
-    let Some(st) = app.histogram.as_ref() else {
+pub fn render(
+    hist: &Option<HistogramState>,
+    app: &Workbench,
+    theme: &Theme,
+    f: &mut Frame,
+    area: Rect,
+) {
+    let Some(st) = hist.as_ref() else {
         f.render_widget(Paragraph::new("no histograms (Esc)"), area);
         return;
     };
@@ -484,7 +429,14 @@ fn axis_chart(
     f.render_widget(chart, area);
 }
 
-fn diff_popup(app: &App, s: &Suggestion, scroll: usize, theme: &Theme, f: &mut Frame, body: Rect) {
+fn diff_popup(
+    app: &Workbench,
+    s: &Suggestion,
+    scroll: usize,
+    theme: &Theme,
+    f: &mut Frame,
+    body: Rect,
+) {
     let diff = s.diff_lines();
     let w = (diff.iter().map(|l| l.len()).max().unwrap_or(40) + 4).max(50) as u16;
     let area = centred(body, w, body.height);
@@ -535,10 +487,12 @@ fn diff_popup(app: &App, s: &Suggestion, scroll: usize, theme: &Theme, f: &mut F
 
 #[cfg(test)]
 mod tests {
-    use super::super::app::{open as open_trial, update};
-    use super::super::headless::{buffer_text, draw, load_app, write_demo_folder};
-    use super::super::jobs::SyncRunner;
     use super::*;
+    use crate::limits::LimitTable;
+    use crate::ui::app::{open as open_trial, update, App, Msg};
+    use crate::ui::headless::{buffer_text, draw, load_app, write_demo_folder};
+    use crate::ui::jobs::histogram::{compute_job, write_job};
+    use crate::ui::jobs::SyncRunner;
     use ratatui::crossterm::event::{KeyCode, KeyEvent};
 
     fn key(app: &mut App, c: KeyCode) {
@@ -546,7 +500,7 @@ mod tests {
     }
 
     fn snap(name: &str, app: &App) {
-        for (w, h) in super::super::tests::SIZES {
+        for (w, h) in crate::ui::tests::SIZES {
             let text = buffer_text(&draw(app, &Theme::default(), w, h));
             insta::assert_snapshot!(format!("{name}_{w}x{h}"), text);
         }
@@ -618,7 +572,7 @@ mod tests {
         let Msg::Histograms(stale) = compute_job(trials, TimeSpan::WHOLE, table) else {
             unreachable!()
         };
-        assert!(received(&mut app, *stale).is_empty());
+        assert!(received(&mut app.histogram, &mut app.wb, *stale).is_empty());
         assert!(app.histogram.as_ref().unwrap().computing);
         // Enter while computing waits for the job instead of blocking.
         let waits = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Enter)));

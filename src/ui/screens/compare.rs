@@ -1,10 +1,12 @@
 //! The compare screen: every variant side by side; choose one and save it.
 
-use super::app::App;
-use super::render::{fit, num};
-use super::theme::Theme;
 use crate::acm::Variant;
 use crate::metrics::JointFigures;
+use crate::ui::cells::{fit, num};
+use crate::ui::keymap::Action;
+use crate::ui::msg::{Effect, Nav, Reply, Screen};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::Workbench;
 use ratatui::layout::Rect;
 use ratatui::style::Style;
 use ratatui::text::{Line, Span};
@@ -26,7 +28,7 @@ fn column_label(v: Variant) -> &'static str {
     }
 }
 
-pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(col: usize, app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(e) = app.open_entry() else {
         f.render_widget(Paragraph::new("no trial open"), area);
         return;
@@ -34,12 +36,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let truth = e.loaded().is_some_and(|l| l.truth.is_some());
     let cw = if truth { 14 } else { 8 };
     let nw = 12usize;
-    let cols = visible_columns(
-        area.width as usize,
-        2 + nw + cw,
-        cw.max(15),
-        app.compare_col,
-    );
+    let cols = visible_columns(area.width as usize, 2 + nw + cw, cw.max(15), col);
     let mut title = if truth {
         "joint mean excursion, deg  /  truth RMS error, deg (mean of X Y Z)".to_string()
     } else {
@@ -69,7 +66,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             name = format!("*{name}");
         }
         let name = fit(&name, cw.max(15) - 1).trim_end().to_string();
-        let style = if k == app.compare_col {
+        let style = if k == col {
             theme.selected.patch(theme.header)
         } else {
             theme.header
@@ -112,7 +109,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     for (k, (name, cells)) in rows.iter().enumerate() {
         let mut spans = vec![Span::raw(format!("{name}{:>w$}", cells[0], w = cw))];
         for (c, text) in cells[1..].iter().enumerate() {
-            let style = if cols.start + c == app.compare_col {
+            let style = if cols.start + c == col {
                 theme.corrected
             } else {
                 Style::default()
@@ -143,7 +140,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     lines.push(Line::from(""));
     let mut status = vec![];
     for v in Variant::ALL {
-        let s = super::trials::variant_status(e, v);
+        let s = e.variant_status(v);
         let saved = e
             .results
             .get(&v)
@@ -180,4 +177,56 @@ fn visible_columns(
     let fit = (width.saturating_sub(fixed) / col_w.max(1)).clamp(1, all);
     let start = selected.min(all - 1).saturating_sub(fit - 1);
     start..start + fit
+}
+
+/// What a key does on the compare screen; `col` is the picked column.
+pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
+    let Some(file) = app.open.clone() else {
+        return Reply::nav(Nav::To(Screen::Trials));
+    };
+    match a {
+        Action::Back => return Reply::nav(Nav::To(Screen::Trial)),
+        Action::Left => *col = col.saturating_sub(1),
+        Action::Right => *col = (*col + 1).min(Variant::ALL.len() - 1),
+        Action::Up => app.joint = app.joint.saturating_sub(1),
+        Action::Down => app.joint = (app.joint + 1).min(app.open_joints().len().saturating_sub(1)),
+        Action::Run => return app.run_effect(&file, None).into(),
+        Action::Choose | Action::Enter => {
+            // The choice is this trial's; the variant shown stays as it is.
+            let v = Variant::ALL[*col];
+            if let Some(e) = app.entry_mut(&file) {
+                e.chosen = Some(v);
+            }
+            app.info(format!("chose {v}; w saves it"));
+        }
+        Action::Save => {
+            let v = app
+                .entry(&file)
+                .and_then(|e| e.chosen)
+                .unwrap_or(Variant::ALL[*col]);
+            let limits = app.limits.table.clone();
+            let limits_source = app.limits.source.clone();
+            let Some(e) = app.entry_mut(&file) else {
+                return Reply::default();
+            };
+            let (Some(loaded), Some(r)) = (e.loaded().cloned(), e.results.get(&v)) else {
+                app.error(format!("run the corrections first (r): {v} is not done"));
+                return Reply::default();
+            };
+            e.chosen = Some(v);
+            e.saving = Some(v);
+            let effect = Effect::SaveVariant {
+                file: file.clone(),
+                path: e.path.clone(),
+                loaded,
+                correction: r.correction.clone(),
+                limits,
+                limits_source,
+            };
+            app.info(format!("saving {file} {v}..."));
+            return vec![effect].into();
+        }
+        _ => {}
+    }
+    Reply::default()
 }

@@ -3,10 +3,11 @@
 //! beside corrected. Left/Right scrub by a second (PgUp/PgDn ten), Home/End
 //! jump, Space or `p` plays.
 
-use super::app::{App, TrialEntry};
-use super::theme::Theme;
-use super::views::{colour, marker, square_bounds};
+use super::Ctx;
+use super::{colour, marker, square_bounds};
 use crate::analysis::stick::{BodyFrame, Segment, Skeleton};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::TrialEntry;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Color;
 use ratatui::text::{Line, Span};
@@ -52,7 +53,7 @@ struct Panel<'a> {
     reach: f64,
 }
 
-fn panel(f: &mut Frame, area: Rect, theme: &Theme, app: &App, p: Panel) {
+fn panel(f: &mut Frame, area: Rect, theme: &Theme, app: &Ctx, p: Panel) {
     let Panel {
         title,
         bones,
@@ -92,7 +93,7 @@ fn panel(f: &mut Frame, area: Rect, theme: &Theme, app: &App, p: Panel) {
     f.render_widget(canvas, area);
 }
 
-pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(l) = e.loaded() else {
         return;
     };

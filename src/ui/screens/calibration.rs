@@ -4,33 +4,20 @@
 //! residual angle of each axis at the identity start and after the LM fit
 //! (its Figure 5), and the fit per IMU.
 //!
-//! State, update and drawing of the screen live here; `app.rs` only routes.
-//! Reading and calibrating run as an effect ([`scan`]), never in `update`.
+//! State, keys and drawing of the screen live here; reading and calibrating
+//! run as a background job, never in `update`.
 
-use super::app::{App, Effect, Msg, Screen};
-use super::keymap::Action;
-use super::render::{fit, sel};
-use super::theme::Theme;
-use crate::calibration::{calibrate, is_calibration_recording, Calibration, Protocol, Recording};
+use crate::calibration::Calibration;
 use crate::rotation::angle_deg;
+use crate::ui::cells::{fit, sel};
+use crate::ui::keymap::Action;
+use crate::ui::msg::{CalibEntry, Effect, Nav, Reply, Screen};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::Workbench;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph};
 use ratatui::Frame;
-use std::path::Path;
-use std::sync::Arc;
-
-/// The protocol file the workbench uses when the folder has one.
-pub const FOLDER_PROTOCOL: &str = "protocol.toml";
-
-/// One calibration recording of the folder and what became of it.
-#[derive(Debug, Clone)]
-pub struct CalibEntry {
-    /// File name inside the folder.
-    pub file: String,
-    /// The calibration, or why the recording could not be read.
-    pub result: Result<Arc<Calibration>, String>,
-}
 
 /// What the calibration screen shows.
 #[derive(Debug, Clone, Default)]
@@ -44,32 +31,29 @@ pub struct CalibState {
     pub protocol: String,
 }
 
-/// Opens the screen and starts reading the folder's recordings.
-pub fn enter(app: &mut App) -> Vec<Effect> {
-    app.screen = Screen::Calibration;
-    app.calib.loading = true;
+/// Starts reading the folder's recordings (the screen is opening or `r`).
+pub fn enter(c: &mut CalibState, app: &Workbench) -> Vec<Effect> {
+    c.loading = true;
     vec![Effect::Calibrations {
         dir: app.dir.clone(),
     }]
 }
 
 /// A key on the calibration screen.
-pub fn action(app: &mut App, a: Action) -> Vec<Effect> {
-    let c = &mut app.calib;
+pub fn action(c: &mut CalibState, app: &mut Workbench, a: Action) -> Reply {
     let n = c.entries.len();
     match a {
-        Action::Back => app.screen = Screen::Trials,
+        Action::Back => return Reply::nav(Nav::To(Screen::Trials)),
         Action::Up => c.selected = c.selected.saturating_sub(1),
         Action::Down => c.selected = (c.selected + 1).min(n.saturating_sub(1)),
-        Action::Run => return enter(app),
+        Action::Run => return enter(c, app).into(),
         _ => {}
     }
-    vec![]
+    Reply::default()
 }
 
 /// The end of a scan.
-pub fn loaded(app: &mut App, entries: Vec<CalibEntry>, protocol: String) {
-    let c = &mut app.calib;
+pub fn loaded(c: &mut CalibState, entries: Vec<CalibEntry>, protocol: String) {
     let keep = c.entries.get(c.selected).map(|e| e.file.clone());
     c.entries = entries;
     c.protocol = protocol;
@@ -82,55 +66,8 @@ pub fn loaded(app: &mut App, entries: Vec<CalibEntry>, protocol: String) {
         .min(c.entries.len().saturating_sub(1));
 }
 
-/// Reads and calibrates every recording in `dir` with the folder's
-/// `protocol.toml`, or the built-in protocol when there is none.
-pub fn scan(dir: &Path) -> Msg {
-    let (protocol, label) = match std::fs::read_to_string(dir.join(FOLDER_PROTOCOL)) {
-        Ok(text) => (
-            Protocol::from_toml(&text, FOLDER_PROTOCOL).map_err(|e| e.to_string()),
-            FOLDER_PROTOCOL.to_string(),
-        ),
-        Err(_) => {
-            let p = Protocol::default_protocol();
-            let label = format!("<built-in {}>", p.name);
-            (Ok(p), label)
-        }
-    };
-    let mut files: Vec<String> = std::fs::read_dir(dir)
-        .map(|rd| {
-            rd.filter_map(|e| e.ok())
-                .map(|e| e.path())
-                .filter(|p| p.is_file() && is_calibration_recording(p))
-                .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-                .collect()
-        })
-        .unwrap_or_default();
-    files.sort();
-    let entries = files
-        .into_iter()
-        .map(|file| {
-            let result = match &protocol {
-                Err(m) => Err(m.clone()),
-                Ok(p) => Recording::read(&dir.join(&file))
-                    .map(|r| Arc::new(calibrate(&r, p)))
-                    .map_err(|e| {
-                        // Name the file as the folder shows it.
-                        crate::calibration::CalibrationError {
-                            file: file.clone(),
-                            ..e
-                        }
-                        .to_string()
-                    }),
-            };
-            CalibEntry { file, result }
-        })
-        .collect();
-    Msg::Calibrations(entries, label)
-}
-
 /// Draws the screen.
-pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
-    let c = &app.calib;
+pub fn render(c: &CalibState, theme: &Theme, f: &mut Frame, area: Rect) {
     let list_h = (c.entries.len().max(1) as u16 + 1)
         .min(area.height / 4)
         .max(2);
@@ -299,40 +236,14 @@ fn fit_right(s: &str, w: usize) -> String {
     }
 }
 
-/// Writes the demo folder's calibration recordings into `dir`: `cal.calib.csv`
-/// (the built-in protocol simulated at 50 Hz, 4 repetitions per movement, the
-/// thorax rotation TR sloppy) and `bad.calib.csv` (a malformed number on line 3).
-pub fn write_demo_recordings(dir: &Path) -> Result<(), String> {
-    use crate::calibration::simulate::{simulate, CalibSimConfig, Sloppiness};
-    let mut config = CalibSimConfig {
-        rate_hz: 50.0,
-        reps: 4,
-        ..CalibSimConfig::default()
-    };
-    config.overrides.insert(
-        "TR".into(),
-        Sloppiness {
-            wobble_deg: 30.0,
-            bias_deg: 6.0,
-        },
-    );
-    let sim = simulate(&Protocol::default_protocol(), &config).map_err(|e| e.to_string())?;
-    std::fs::write(dir.join("cal.calib.csv"), sim.recording.to_csv()).map_err(|e| e.to_string())?;
-    std::fs::write(
-        dir.join("bad.calib.csv"),
-        "time,label,upper_back_ax,upper_back_ay,upper_back_az,upper_back_gx,upper_back_gy,upper_back_gz\n0,supine,0,0,9.8,0,0,0\n0.02,supine,0,0,9.8,0,1..5,0\n",
-    )
-    .map_err(|e| e.to_string())
-}
-
 #[cfg(test)]
 mod tests {
-    use super::super::app::{App, Msg, Screen};
-    use super::super::headless::{load_app, write_demo_folder};
-    use super::super::jobs::SyncRunner;
-    use super::super::render::render;
-    use super::super::tests::SIZES;
-    use super::super::theme::Theme;
+    use crate::ui::app::{App, Msg, Screen};
+    use crate::ui::headless::{load_app, write_demo_folder};
+    use crate::ui::jobs::SyncRunner;
+    use crate::ui::render::render;
+    use crate::ui::tests::SIZES;
+    use crate::ui::theme::Theme;
     use ratatui::backend::TestBackend;
     use ratatui::crossterm::event::{KeyCode, KeyEvent};
     use ratatui::Terminal;
@@ -396,7 +307,7 @@ mod tests {
         assert!(app.calib.entries.is_empty());
         let mut t = Terminal::new(TestBackend::new(80, 24)).unwrap();
         t.draw(|f| render(&app, &Theme::default(), f)).unwrap();
-        let text = super::super::headless::buffer_text(t.backend().buffer());
+        let text = crate::ui::headless::buffer_text(t.backend().buffer());
         assert!(text.contains("no calibration recordings"), "{text}");
         write_demo_folder(&dir).unwrap();
         key(&mut app, KeyCode::Char('r'));

@@ -3,10 +3,11 @@
 //! components in the sensor frame, with the window centres it was slerped
 //! between marked.
 
-use super::app::{App, TrialEntry};
-use super::theme::Theme;
-use super::views::{colour, marker};
+use super::Ctx;
+use super::{colour, marker};
 use crate::analysis::applied::AppliedCorrection;
+use crate::ui::theme::Theme;
+use crate::ui::workbench::TrialEntry;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
 use ratatui::text::{Line, Span};
@@ -36,7 +37,7 @@ fn labels(b: [f64; 2], h: u16) -> Vec<String> {
     }
 }
 
-pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(l) = e.loaded() else {
         return;
     };

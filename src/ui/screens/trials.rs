@@ -1,24 +1,16 @@
 //! The trials screen: every trial file of the folder, its status and figures.
 
-use super::app::{App, LoadState, TrialEntry};
-use super::render::{fit, num, sel};
-use super::theme::Theme;
 use crate::acm::Variant;
+use crate::ui::cells::{fit, num, sel};
+use crate::ui::keymap::Action;
+use crate::ui::msg::{Nav, Reply};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::{LoadState, SortKey, Workbench};
+use ratatui::crossterm::event::{KeyCode, KeyEvent};
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 use ratatui::Frame;
-
-/// Status of one variant of a trial, as shown.
-pub fn variant_status(e: &TrialEntry, v: Variant) -> String {
-    match e.results.get(&v) {
-        Some(r) if r.saved.is_some() => "saved".into(),
-        Some(_) if e.chosen == Some(v) => "chosen".into(),
-        _ if e.running.is_some() => format!("{}%", e.running.unwrap_or(0)),
-        Some(_) => "done".into(),
-        None => "-".into(),
-    }
-}
 
 /// A variant's name in a 7-character column.
 fn short_name(v: Variant) -> &'static str {
@@ -41,7 +33,7 @@ fn name_header(filter: &str, sort: &str) -> String {
     }
 }
 
-pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let details_h = if area.height >= 16 { 5 } else { 0 };
     let [list, details] =
         Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area);
@@ -108,7 +100,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                     l.trial.imus.len()
                 );
                 for &v in variants {
-                    s.push_str(&format!("{:>7}", variant_status(e, v)));
+                    s.push_str(&format!("{:>7}", e.variant_status(v)));
                 }
                 s.push_str(&num(e.mean_excursion(None), 7));
                 s.push_str(&num(e.mean_excursion(Some(app.variant)), 7));
@@ -161,4 +153,66 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             details,
         );
     }
+}
+
+/// What a key does on the trials screen.
+pub fn action(app: &mut Workbench, a: Action) -> Reply {
+    let n = app.visible().len();
+    match a {
+        Action::Up => app.selected = app.selected.saturating_sub(1),
+        Action::Down => app.selected = (app.selected + 1).min(n.saturating_sub(1)),
+        Action::PageUp => app.selected = app.selected.saturating_sub(10),
+        Action::PageDown => app.selected = (app.selected + 10).min(n.saturating_sub(1)),
+        Action::Filter => app.filter_editing = true,
+        Action::Back => app.filter.clear(),
+        Action::Sort => {
+            app.sort = match app.sort {
+                SortKey::Name => SortKey::Duration,
+                SortKey::Duration => SortKey::Excursion,
+                SortKey::Excursion => SortKey::Name,
+            };
+            app.sort_trials();
+        }
+        Action::Variant => app.next_variant(),
+        Action::Calibration => return Reply::nav(Nav::Calibration),
+        Action::Enter | Action::Right => {
+            let Some(e) = app.selected_entry() else {
+                return Reply::default();
+            };
+            match &e.load {
+                LoadState::Loaded(_) => {
+                    return Reply::nav(Nav::OpenTrial(e.file.clone()));
+                }
+                LoadState::Pending => app.info(format!("{} is still loading", e.file)),
+                LoadState::Failed(m) => {
+                    let m = m.clone();
+                    app.error(m)
+                }
+            }
+        }
+        Action::Run => {
+            if let Some(f) = app.selected_entry().map(|e| e.file.clone()) {
+                return app.run_effect(&f, None).into();
+            }
+        }
+        _ => {}
+    }
+    Reply::default()
+}
+
+/// A key while the name filter is being typed.
+pub fn filter_key(app: &mut Workbench, k: KeyEvent) {
+    match k.code {
+        KeyCode::Enter => app.filter_editing = false,
+        KeyCode::Esc => {
+            app.filter_editing = false;
+            app.filter.clear();
+        }
+        KeyCode::Backspace => {
+            app.filter.pop();
+        }
+        KeyCode::Char(c) => app.filter.push(c),
+        _ => {}
+    }
+    app.selected = 0;
 }

@@ -2,15 +2,16 @@
 //! as three projections (X-Y, X-Z, Y-Z), uncorrected beside corrected, points
 //! coloured by limit class (or by time with `t`), the limits as rectangles.
 
-use super::app::{App, TrialEntry};
-use super::theme::Theme;
-use super::views::{
+use super::Ctx;
+use super::{
     colour, joint_data, marker, resolution, RasterShape, BAND_COLOUR, CLASS_COLOURS, TIME_COLOURS,
 };
 use crate::analysis::scatter::{
     axis_bounds, scatter_rasters, ClassCounts, Colouring, LimitClass, Raster, PROJECTIONS,
 };
 use crate::limits::axis_name;
+use crate::ui::theme::Theme;
+use crate::ui::workbench::TrialEntry;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Style;
 use ratatui::text::{Line, Span};
@@ -19,7 +20,7 @@ use ratatui::widgets::{Block, Borders, Paragraph};
 use ratatui::Frame;
 
 /// The colouring the view is set to.
-pub fn colouring(app: &App) -> Colouring {
+pub fn colouring(app: &Ctx) -> Colouring {
     if app.views.time_colour {
         Colouring::Time
     } else {
@@ -67,7 +68,7 @@ pub fn legend(
 
 /// The legend of the raw and corrected angles of a view.
 pub fn legend_of(
-    app: &App,
+    app: &Ctx,
     theme: &Theme,
     c: Colouring,
     range: &[[f64; 2]; 3],
@@ -84,7 +85,7 @@ pub fn legend_of(
     legend(theme, c, &panels)
 }
 
-pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(d) = joint_data(app, e) else {
         f.render_widget(
             Paragraph::new("no joint with both IMUs in this trial"),

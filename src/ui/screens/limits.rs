@@ -1,9 +1,12 @@
 //! The limits editor: the joint x axis table and the settings, edited in place.
 
-use super::app::{App, SETTING_NAMES};
-use super::render::fit;
-use super::theme::Theme;
 use crate::limits::HEADER;
+use crate::ui::cells::fit;
+use crate::ui::keymap::Action;
+use crate::ui::msg::{Effect, Nav, Reply, Screen};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::{CellEdit, Workbench, FIRST_EDIT_COL, LAST_COL, SETTING_NAMES};
+use ratatui::crossterm::event::{KeyCode, KeyEvent};
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Modifier, Style};
 use ratatui::text::{Line, Span};
@@ -24,10 +27,10 @@ fn widths(total: usize) -> [usize; 7] {
     ]
 }
 
-pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let l = &app.limits;
     let [head, table, foot] = Layout::vertical([
-        Constraint::Length(1),
+        Constraint::Length(1 + u16::from(l.disk_error.is_some())),
         Constraint::Min(1),
         Constraint::Length(3),
     ])
@@ -37,13 +40,17 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     } else {
         ""
     };
-    f.render_widget(
-        Paragraph::new(Line::from(vec![
-            Span::raw(format!(" {} ", l.source)),
-            Span::styled(dirty, theme.edited),
-        ])),
-        head,
-    );
+    let mut heading = vec![Line::from(vec![
+        Span::raw(format!(" {} ", l.source)),
+        Span::styled(dirty, theme.edited),
+    ])];
+    if let Some(why) = &l.disk_error {
+        heading.push(Line::from(Span::styled(
+            format!(" ! on disk: {why}; in use: the last good table"),
+            theme.error,
+        )));
+    }
+    f.render_widget(Paragraph::new(heading), head);
     let w = widths(table.width as usize);
     let mut lines = vec![];
     let mut h = String::from("  ");
@@ -99,7 +106,13 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     );
 }
 
-fn cell_spans(app: &App, theme: &Theme, row: usize, col: usize, w: usize) -> Vec<Span<'static>> {
+fn cell_spans(
+    app: &Workbench,
+    theme: &Theme,
+    row: usize,
+    col: usize,
+    w: usize,
+) -> Vec<Span<'static>> {
     let l = &app.limits;
     let on_setting = row >= l.table.rows.len();
     let selected = row == l.row && (on_setting || col == l.col);
@@ -170,10 +183,93 @@ fn fit_right(s: &str, w: usize) -> String {
     }
 }
 
+/// What a key does on the limits editor; Esc returns to `from`.
+pub fn action(app: &mut Workbench, from: Screen, a: Action) -> Reply {
+    let l = &mut app.limits;
+    let n = l.rows();
+    match a {
+        Action::Back => return Reply::nav(Nav::To(from)),
+        Action::Up => l.row = l.row.saturating_sub(1),
+        Action::Down => l.row = (l.row + 1).min(n.saturating_sub(1)),
+        Action::PageUp => l.row = l.row.saturating_sub(10),
+        Action::PageDown => l.row = (l.row + 10).min(n.saturating_sub(1)),
+        Action::Left => l.col = l.col.saturating_sub(1).max(FIRST_EDIT_COL),
+        Action::Right => l.col = (l.col + 1).min(LAST_COL),
+        Action::Enter => {
+            let text = l.cell_text(l.row, l.col);
+            l.edit = Some(CellEdit::new(text));
+        }
+        Action::Save => {
+            let (table, settings) = (l.table.clone(), l.settings.clone());
+            l.saved_table = table.clone();
+            l.saved_settings = settings.clone();
+            l.saving = true;
+            let effect = Effect::SaveLimits {
+                dir: l.dir.clone(),
+                table_name: l.table_name.clone(),
+                table_csv: table.to_csv(),
+                settings_toml: settings.to_toml(),
+            };
+            app.info(format!("saving {}...", app.limits.table_name));
+            return vec![effect].into();
+        }
+        _ => {}
+    }
+    Reply::default()
+}
+/// A key while a cell is being edited.
+pub fn edit_key(app: &mut Workbench, k: KeyEvent) -> Reply {
+    let l = &mut app.limits;
+    let Some(edit) = l.edit.as_mut() else {
+        return Reply::default();
+    };
+    match k.code {
+        KeyCode::Esc => {
+            l.edit = None;
+            return Reply::default();
+        }
+        KeyCode::Enter => {
+            let text = edit.text.clone();
+            let applied = l.apply(&text);
+            match applied {
+                Ok((table, settings)) => {
+                    let settings_changed = settings != l.settings;
+                    if let Some(r) = l.table.rows.get(l.row) {
+                        l.pending.get_or_insert_with(Vec::new).push(r.joint.clone());
+                    }
+                    l.pending_all |= settings_changed;
+                    l.table = table;
+                    l.settings = settings;
+                    l.edit = None;
+                    app.settings = app.limits.settings.settings();
+                    return vec![Effect::Debounce].into();
+                }
+                Err(m) => {
+                    if let Some(edit) = l.edit.as_mut() {
+                        edit.error = Some(m);
+                    }
+                    return Reply::default();
+                }
+            }
+        }
+        _ => {
+            if !edit.key(k) {
+                return Reply::default();
+            }
+        }
+    }
+    let text = edit.text.clone();
+    let err = l.apply(&text).err();
+    if let Some(edit) = l.edit.as_mut() {
+        edit.error = err;
+    }
+    Reply::default()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ui::app::CellEdit;
+    use crate::ui::workbench::CellEdit;
     use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
     fn press(e: &mut CellEdit, codes: &[KeyCode]) {

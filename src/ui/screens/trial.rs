@@ -1,10 +1,12 @@
 //! The trial screen: joints, three angle charts with limits, figures.
 
-use super::app::{App, TrialEntry};
-use super::render::{fit, num, sel};
-use super::theme::Theme;
 use crate::limits::axis_name;
 use crate::metrics::JointFigures;
+use crate::ui::cells::{fit, num, sel};
+use crate::ui::keymap::Action;
+use crate::ui::msg::{Nav, Reply, Screen, ViewKind};
+use crate::ui::theme::Theme;
+use crate::ui::workbench::{TrialEntry, View, Workbench};
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Style;
 use ratatui::symbols::Marker;
@@ -41,7 +43,7 @@ fn figures_of<'a>(figs: Option<&'a [JointFigures]>, joint: &str) -> Option<&'a J
     figs?.iter().find(|f| f.joint == joint)
 }
 
-pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(e) = app.open_entry() else {
         f.render_widget(Paragraph::new("no trial open (Esc)"), area);
         return;
@@ -111,7 +113,7 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let d = l.trial.duration_s();
     let (s0, s1) = app.view.span(d);
     let ci = index_at(t, app.view.cursor_s + origin);
-    let glitches = super::glitches::of_joint(l, &joint.name);
+    let glitches = crate::ui::glitches::of_joint(l, &joint.name);
     let [charts, foot] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
     let parts = Layout::vertical([Constraint::Ratio(1, 3); 3]).split(charts);
     for axis in 0..3 {
@@ -150,12 +152,17 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                 span: (s0, s1),
                 cursor: app.view.cursor_s,
                 braille: app.view.braille,
-                glitches: super::glitches::markers(&glitches, &raw, axis, (s0, s1)),
+                glitches: crate::ui::glitches::markers(&glitches, &raw, axis, (s0, s1)),
             },
         );
     }
+    let note = e
+        .variant_note_short(app.variant)
+        .filter(|_| e.running.is_none());
     let status = if let Some(p) = e.running {
         format!("running {p}%")
+    } else if note.is_some() {
+        String::new()
     } else if e.results.contains_key(&app.variant) {
         format!("{} done", app.variant)
     } else {
@@ -169,12 +176,13 @@ pub fn render(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
                 app.view.cursor_s
             )),
             Span::styled(
-                super::glitches::footer(&glitches, app.view.cursor_s).unwrap_or_default(),
+                crate::ui::glitches::footer(&glitches, app.view.cursor_s).unwrap_or_default(),
                 theme.warn,
             ),
             Span::styled(status, theme.dim),
+            Span::styled(note.unwrap_or_default(), theme.warn),
             Span::styled(
-                super::pose::label(l)
+                crate::ui::pose::label(l)
                     .map(|p| format!("  {p}"))
                     .unwrap_or_default(),
                 theme.header,
@@ -299,7 +307,14 @@ fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
     f.render_widget(chart, area);
 }
 
-fn figures_panel(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect, joint: &str) {
+fn figures_panel(
+    app: &Workbench,
+    e: &TrialEntry,
+    theme: &Theme,
+    f: &mut Frame,
+    area: Rect,
+    joint: &str,
+) {
     let before = figures_of(e.figures(None), joint);
     let after = figures_of(e.figures(Some(app.variant)), joint);
     let row = |label: &str, v: Option<[f64; 3]>| {
@@ -343,4 +358,109 @@ fn figures_panel(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: 
         ),
         area,
     );
+}
+
+/// Opens a trial on the trial screen.
+pub fn open(app: &mut Workbench, file: String) {
+    if app.open.as_deref() != Some(file.as_str()) {
+        app.joint = 0;
+        app.view = View {
+            braille: app.view.braille,
+            ..View::default()
+        };
+    }
+    app.select_file(&file);
+    app.open = Some(file);
+}
+
+/// What a key does on the trial screen.
+pub fn action(app: &mut Workbench, a: Action) -> Reply {
+    let joints = app.open_joints().len();
+    let d = app
+        .open_entry()
+        .and_then(|e| e.loaded())
+        .map_or(0.0, |l| l.trial.duration_s());
+    let (s0, s1) = app.view.span(d);
+    let step = (s1 - s0) / 50.0;
+    match a {
+        Action::Back => return Reply::nav(Nav::To(Screen::Trials)),
+        Action::Up => app.joint = app.joint.saturating_sub(1),
+        Action::Down => app.joint = (app.joint + 1).min(joints.saturating_sub(1)),
+        Action::ZoomIn => zoom(app, true),
+        Action::ZoomOut => zoom(app, false),
+        Action::Left => app.view.start_s = (s0 - (s1 - s0) / 4.0).max(0.0),
+        Action::Right => app.view.start_s = (s0 + (s1 - s0) / 4.0).min((d - (s1 - s0)).max(0.0)),
+        Action::CursorLeft => app.view.cursor_s = (app.view.cursor_s - step).clamp(0.0, d),
+        Action::CursorRight => app.view.cursor_s = (app.view.cursor_s + step).clamp(0.0, d),
+        Action::Home => app.view.cursor_s = 0.0,
+        Action::End => app.view.cursor_s = d,
+        Action::Marker => app.view.braille = !app.view.braille,
+        Action::NextGlitch => next_glitch(app),
+        Action::Variant => app.next_variant(),
+        Action::Pose => return crate::ui::pose::toggle(app).into(),
+        Action::Scatter => return Reply::nav(Nav::View(ViewKind::Scatter)),
+        Action::Globe => return Reply::nav(Nav::View(ViewKind::Globe)),
+        Action::Applied => return Reply::nav(Nav::View(ViewKind::Applied)),
+        Action::Stick => return Reply::nav(Nav::View(ViewKind::Stick)),
+        Action::HeadingDrift => return Reply::nav(Nav::View(ViewKind::Heading)),
+        Action::Compare => return Reply::nav(Nav::Compare),
+        Action::Run => {
+            if let Some(f) = app.open.clone() {
+                return app.run_effect(&f, None).into();
+            }
+        }
+        _ => {}
+    }
+    // Keep the cursor in view when it moved.
+    if matches!(
+        a,
+        Action::CursorLeft | Action::CursorRight | Action::Home | Action::End | Action::NextGlitch
+    ) {
+        let (s0, s1) = app.view.span(d);
+        let w = s1 - s0;
+        let c = app.view.cursor_s;
+        if c < s0 || c > s1 {
+            app.view.start_s = (c - w / 2.0).clamp(0.0, (d - w).max(0.0));
+        }
+    }
+    Reply::default()
+}
+
+/// Moves the cursor to the selected joint's next glitch (wrapping).
+fn next_glitch(app: &mut Workbench) {
+    let Some(l) = app.open_entry().and_then(|e| e.loaded()) else {
+        return;
+    };
+    let Some(joint) = l.before.get(app.joint).map(|f| f.joint.clone()) else {
+        return;
+    };
+    let found = crate::ui::glitches::of_joint(l, &joint);
+    if let Some(t) = crate::ui::glitches::next_after(&found, app.view.cursor_s) {
+        app.view.cursor_s = t;
+    }
+}
+
+/// Zooms the time axis in or out about the cursor (or the centre when the
+/// cursor is out of view).
+pub fn zoom(app: &mut Workbench, zoom_in: bool) {
+    let Some(d) = app
+        .open_entry()
+        .and_then(|e| e.loaded())
+        .map(|l| l.trial.duration_s())
+    else {
+        return;
+    };
+    let (a, b) = app.view.span(d);
+    let centre = if app.view.cursor_s >= a && app.view.cursor_s <= b {
+        app.view.cursor_s
+    } else {
+        (a + b) / 2.0
+    };
+    if zoom_in {
+        app.view.zoom = (app.view.zoom + 1).min(12);
+    } else {
+        app.view.zoom = app.view.zoom.saturating_sub(1);
+    }
+    let w = d / f64::from(1u32 << app.view.zoom);
+    app.view.start_s = (centre - w / 2.0).clamp(0.0, (d - w).max(0.0));
 }

@@ -2,10 +2,11 @@
 //! heading-drift variant estimated for every IMU over time, in degrees about
 //! the global vertical, and its rates in degrees per second.
 
-use super::app::{App, TrialEntry};
-use super::render::fit;
-use super::theme::Theme;
+use super::Ctx;
 use crate::acm::{ImuHeading, Variant};
+use crate::ui::cells::fit;
+use crate::ui::theme::Theme;
+use crate::ui::workbench::{TrialEntry, Workbench};
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Style;
 use ratatui::symbols::Marker;
@@ -18,7 +19,7 @@ pub const SHOWN_DEG: f64 = 0.05;
 
 /// The heading-drift run the view shows: the current variant when it is one,
 /// else the first heading variant that has a result.
-pub fn shown_variant(app: &App, e: &TrialEntry) -> Option<Variant> {
+pub fn shown_variant(app: &Workbench, e: &TrialEntry) -> Option<Variant> {
     let candidates = [
         app.variant,
         Variant::DriftHeadingCentroid,
@@ -45,7 +46,7 @@ fn styles(theme: &Theme) -> [Style; 5] {
 }
 
 /// Draws the view.
-pub fn render(app: &App, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
+pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
     let Some(v) = shown_variant(app, e) else {
         let text = vec![
             Line::from(Span::styled(
@@ -213,10 +214,10 @@ fn rows(c: &crate::acm::Correction, hs: &[&ImuHeading], theme: &Theme, f: &mut F
 
 #[cfg(test)]
 mod tests {
-    use super::super::headless::{buffer_text, draw, load_app, show, Show};
-    use super::super::theme::Theme;
     use crate::simulate::{preset, simulate, HeadingDrift};
     use crate::trial::{write_trial, TrialFormat};
+    use crate::ui::headless::{buffer_text, draw, load_app, show, Show};
+    use crate::ui::theme::Theme;
 
     #[test]
     fn heading_view_of_a_drifting_calf() {
@@ -257,7 +258,9 @@ mod tests {
             insta::assert_snapshot!(format!("heading_drift_{w}x{hgt}"), text);
         }
         // Esc goes back to the trial screen.
-        super::super::views::action(&mut app, super::super::keymap::Action::Back);
-        assert_eq!(app.screen, super::super::app::Screen::Trial);
+        let esc =
+            ratatui::crossterm::event::KeyEvent::from(ratatui::crossterm::event::KeyCode::Esc);
+        crate::ui::jobs::SyncRunner::send(&mut app, crate::ui::app::Msg::Key(esc));
+        assert_eq!(app.screen, crate::ui::msg::Screen::Trial);
     }
 }

@@ -2,7 +2,13 @@
 //! returns the message that reports its outcome; the runtime calls them on
 //! worker threads, tests call them in line (see [`SyncRunner`]).
 
-use super::app::{update, App, Effect, LimitsState, Loaded, Msg, RunJob};
+pub mod calibration;
+pub mod histogram;
+pub mod pose;
+
+use super::app::{update, App};
+use super::msg::{Effect, Msg, RunJob};
+use super::workbench::{LimitsState, Loaded, SavedOutput};
 use crate::acm::{correct_trial, recorrect, Correction, RunControl, Variant};
 use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
@@ -66,16 +72,21 @@ pub fn limits_state(dir: &Path, d: LimitsDir) -> LimitsState {
 }
 
 /// Reads the limit files in `dir` as they are on disk now (None if absent or bad).
-pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<(LimitTable, SettingsFile)> {
+pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<Msg> {
     let s = std::fs::read_to_string(dir.join("settings.toml")).ok()?;
-    let settings = SettingsFile::parse(&s, "settings.toml").ok()?;
+    let settings = match SettingsFile::parse(&s, "settings.toml") {
+        Ok(s) => s,
+        Err(e) => return Some(Msg::LimitsInvalid(e.to_string())),
+    };
     let name = if settings.table.is_empty() {
         table_name
     } else {
         &settings.table
     };
-    let table = LimitTable::load(&dir.join(name)).ok()?;
-    Some((table, settings))
+    Some(match LimitTable::load(&dir.join(name)) {
+        Ok(table) => Msg::LimitsOnDisk(table, settings),
+        Err(e) => Msg::LimitsInvalid(e.to_string()),
+    })
 }
 
 /// Reads one trial: the trial, its model, its truth and its uncorrected figures.
@@ -110,7 +121,9 @@ pub fn load_trial(
         };
         let before = trial_figures(&trial, None, truth.as_ref(), &model, limits);
         let glitches = glitches(&trial, glitch_deg);
+        let on_disk = saved_outputs(path, format.output_default(), gzip);
         Ok(Arc::new(Loaded {
+            on_disk,
             glitches,
             trial,
             model,
@@ -125,6 +138,50 @@ pub fn load_trial(
         }))
     })();
     Msg::Loaded(file.to_string(), result)
+}
+
+/// The corrected outputs of `input` on disk whose sidecars record this very
+/// input (by its hash), by variant: what an earlier session saved.
+pub fn saved_outputs(
+    input: &Path,
+    format: crate::trial::TrialFormat,
+    gzip: bool,
+) -> std::collections::BTreeMap<Variant, SavedOutput> {
+    let mut found = std::collections::BTreeMap::new();
+    let mut hash = None;
+    for v in Variant::ALL {
+        let output = default_output(input, v, format, gzip);
+        let side = crate::sidecar::sidecar_path(&output);
+        if !output.is_file() || !side.is_file() {
+            continue;
+        }
+        let Ok(record) = crate::sidecar::Sidecar::load(&side) else {
+            continue;
+        };
+        let hash = hash.get_or_insert_with(|| {
+            crate::trial::input_bytes(input)
+                .map(|b| crate::sidecar::sha256_hex(&b))
+                .unwrap_or_default()
+        });
+        if record.variant != v || record.input.sha256 != *hash {
+            continue;
+        }
+        let shown = input
+            .parent()
+            .and_then(|d| output.strip_prefix(d).ok())
+            .unwrap_or(&output)
+            .display()
+            .to_string();
+        found.insert(
+            v,
+            SavedOutput {
+                shown,
+                settings: record.settings,
+                limits_hash: record.limits.sha256,
+            },
+        );
+    }
+    found
 }
 
 /// Corrects a trial with every variant (or re-corrects the edited joints).
@@ -280,32 +337,23 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
             settings_toml,
         } => vec![save_limits(&dir, &table_name, &table_csv, &settings_toml)],
         Effect::Debounce => vec![Msg::RecorrectDue],
-        Effect::Calibrations { dir } => vec![super::calibration::scan(&dir)],
+        Effect::Calibrations { dir } => vec![calibration::scan(&dir)],
         Effect::Histograms {
             trials,
             span,
             table,
-        } => vec![super::histogram::compute_job(&trials, span, &table)],
+        } => vec![histogram::compute_job(&trials, span, &table)],
         Effect::WriteTable {
             path,
             original,
             csv,
-        } => vec![super::histogram::write_job(
-            &path,
-            original.as_deref(),
-            &csv,
-        )],
+        } => vec![histogram::write_job(&path, original.as_deref(), &csv)],
         Effect::PoseCalibrate {
             file,
             loaded,
             calibration,
             limits,
-        } => vec![super::pose::calibrate_job(
-            &file,
-            &loaded,
-            &calibration,
-            &limits,
-        )],
+        } => vec![pose::calibrate_job(&file, &loaded, &calibration, &limits)],
     }
 }
 

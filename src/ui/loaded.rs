@@ -1,0 +1,66 @@
+//! A trial as read from disk, with what the screens need of it (figures,
+//! glitches, joint angles computed on demand). A leaf: messages and the
+//! workbench both carry it.
+
+use crate::metrics::JointFigures;
+use crate::model::Model;
+use crate::trial::{Trial, TrialFormat};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Joint angles per joint of one trial (raw or corrected), computed the first
+/// time a screen asks: a 30-minute trial has 90,000 samples per joint, too many
+/// to convert on every frame.
+#[derive(Debug, Clone, Default)]
+pub struct AngleCache(Arc<std::sync::Mutex<BTreeMap<String, JointAngles>>>);
+
+/// Z-Y-X angles `[x, y, z]` in degrees, one per sample, shared between frames.
+pub type JointAngles = Arc<Vec<[f64; 3]>>;
+
+impl AngleCache {
+    /// Z-Y-X angles (degrees) of `joint` in `trial`, cached by joint name.
+    pub fn get(&self, trial: &Trial, joint: &crate::model::Joint) -> Option<JointAngles> {
+        let mut map = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(a) = map.get(&joint.name) {
+            return Some(a.clone());
+        }
+        let a = Arc::new(crate::metrics::joint_angles(trial, joint)?);
+        map.insert(joint.name.clone(), a.clone());
+        Some(a)
+    }
+}
+
+/// A trial read from disk, with what the screens need of it.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub trial: Trial,
+    pub model: Model,
+    pub format: TrialFormat,
+    pub gzip: bool,
+    /// True segment orientations when a truth sits beside the trial.
+    pub truth: Option<Trial>,
+    /// Why the truth beside the trial could not be used.
+    pub truth_error: Option<String>,
+    /// Figures of the uncorrected trial.
+    pub before: Vec<JointFigures>,
+    /// Joint angles of the uncorrected trial, filled on demand.
+    pub angles: AngleCache,
+    /// The pose calibration `trial` went through (None: as read).
+    pub pose: Option<crate::pose::PoseRecord>,
+    /// The trial as read, while `trial` is pose-calibrated.
+    pub uncalibrated: Option<Arc<Loaded>>,
+    /// Orientation jumps over the default threshold, by time (key `G`).
+    pub glitches: Vec<crate::trial::glitch::Glitch>,
+    /// Corrected outputs of this very input found on disk (by their sidecars).
+    pub on_disk: BTreeMap<crate::acm::Variant, SavedOutput>,
+}
+
+/// A corrected output found beside a trial, as its sidecar records it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SavedOutput {
+    /// The output's path relative to the trials folder.
+    pub shown: String,
+    /// The settings and the limit table's hash it was corrected with.
+    pub settings: crate::limits::Settings,
+    pub limits_hash: String,
+}
