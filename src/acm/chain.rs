@@ -483,7 +483,11 @@ fn solve_windows_with_axes(
                 return Err(Cancelled);
             }
             let cost = WindowCost::new(&measured[w.first..w.end], limits, lambda1);
-            let s = hinge::minimise_about_axis(&|c| cost.eval(c), family);
+            // The size term counts the turn about the axis only (see `hinge`).
+            let about_axis = |c: &Quat, phi: f64| {
+                cost.eval(c) - lambda1 * angle_deg(c) + lambda1 * phi.abs()
+            };
+            let s = hinge::minimise_about_axis(&about_axis, family);
             if free.is_none() {
                 progress();
             }

@@ -19,7 +19,10 @@
 //! correction: `C(phi) = S R_n(phi)`, with `S` the least rotation taking the
 //! segment axis `n` onto the estimated one and `phi` the turn about `n` that
 //! no axis can show. The limits decide `phi` by a one-dimensional search of
-//! the usual window cost ([`minimise_about_axis`]). An axis is used only where
+//! the usual window cost ([`minimise_about_axis`]) whose size term counts
+//! `|phi|` instead of the angle of `C`: the swing is the axis' to decide, and
+//! beside a large swing the angle of `C` hardly changes with `phi`, so any
+//! noise at the limits would turn `phi` freely. An axis is used only where
 //! the joint turned about it by at least [`MIN_RANGE_DEG`] in the window (and,
 //! for a one-axis hinge, mostly about one axis); elsewhere the window falls
 //! back to the unconstrained correction and its record says why.
@@ -349,12 +352,16 @@ pub struct AxisSolution {
     pub evaluations: usize,
 }
 
-/// Minimises `cost` over the family: a scan of `phi` over the whole turn at
-/// 2 deg steps, then a golden-section search in the steps either side of the
-/// best (lowest `phi` on ties, so the result is deterministic).
-pub fn minimise_about_axis(cost: &dyn Fn(&Quat) -> f64, family: &AxisFamily) -> AxisSolution {
+/// Minimises `cost(C(phi), phi)` (`phi` in degrees) over the family: a scan
+/// of `phi` over the whole turn at 2 deg steps, then a golden-section search
+/// in the steps either side of the best (the first best on ties, so the
+/// result is deterministic).
+pub fn minimise_about_axis(
+    cost: &dyn Fn(&Quat, f64) -> f64,
+    family: &AxisFamily,
+) -> AxisSolution {
     let steps = (360.0 / SCAN_STEP_DEG).round() as usize;
-    let f = |phi: f64| cost(&family.at(phi));
+    let f = |phi: f64| cost(&family.at(phi), wrap180(phi));
     let mut best = (0.0, f(0.0));
     for k in 0..steps {
         let phi = -180.0 + k as f64 * SCAN_STEP_DEG;
@@ -463,7 +470,7 @@ mod tests {
     fn the_scan_finds_the_turn_a_cost_asks_for() {
         let fam = AxisFamily::new(&Vector3::y(), &Vector3::new(0.1, 1.0, 0.0).normalize());
         let target = fam.at(-123.4);
-        let cost = |c: &Quat| crate::rotation::angle_between_deg(c, &target);
+        let cost = |c: &Quat, _: f64| crate::rotation::angle_between_deg(c, &target);
         let s = minimise_about_axis(&cost, &fam);
         assert!((s.phi_deg + 123.4).abs() < 1e-6, "{s:?}");
         assert!(s.cost < 1e-6);
