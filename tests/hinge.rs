@@ -82,7 +82,12 @@ fn thigh_axis_error_deg(trial: &Trial, sim: &Simulated) -> f64 {
 /// The largest flexion axis error over the windows in the thigh and the calf
 /// frame (against `M^-1 y`), degrees.
 fn axis_errors_deg(c: &Correction, sim: &Simulated) -> (f64, f64) {
-    let rec = c.joint("l_knee").unwrap().hinge.as_ref().expect("hinge record");
+    let rec = c
+        .joint("l_knee")
+        .unwrap()
+        .hinge
+        .as_ref()
+        .expect("hinge record");
     let truth = |imu: &str| sim.truth.meta.misalignment(imu).unwrap().inverse() * Vector3::y();
     let (tp, td) = (truth("l_thigh"), truth("l_calf"));
     rec.windows.iter().fold((0.0, 0.0), |(p, d), w| {
@@ -110,7 +115,10 @@ fn a_misaligned_thigh_is_corrected_through_the_knee_axis() {
                 // The hip is skipped (no base IMU): the axis alone turns the thigh.
                 assert!(rec.proximal_turned_by_axis);
                 assert!(knee <= 3.0, "{axis:?} {angle} noise {noise}: knee {knee}");
-                assert!(thigh <= 3.0, "{axis:?} {angle} noise {noise}: thigh {thigh}");
+                assert!(
+                    thigh <= 3.0,
+                    "{axis:?} {angle} noise {noise}: thigh {thigh}"
+                );
                 assert!(ap < 1.0 && ad < 1.0, "axis errors {ap} / {ad}");
             }
         }
@@ -156,7 +164,10 @@ fn a_knee_that_barely_moves_falls_back_to_drift_centroid() {
     assert!(!rec.proximal_turned_by_axis);
     for w in &rec.windows {
         let why = w.fallback.as_deref().unwrap();
-        assert!(why.contains("hardly moved") || why.contains("0.0 deg about"), "{w:?}");
+        assert!(
+            why.contains("hardly moved") || why.contains("0.0 deg about"),
+            "{w:?}"
+        );
     }
     // Nothing was constrained: the result is drift-centroid's.
     let dc = run(&trial, Variant::DriftCentroid);
@@ -184,12 +195,21 @@ fn the_upper_joint_s_correction_keeps_the_axis_of_the_hinge_below() {
         let rec = c.joint(&j.name).unwrap().hinge.as_ref().unwrap();
         let (np, nd) = j.hinge.unwrap().segment_axes();
         let m = |imu: &str| sim.truth.meta.misalignment(imu).unwrap().inverse();
-        let (tp, td) = (m(&j.proximal) * Vector3::from(np), m(&j.distal) * Vector3::from(nd));
+        let (tp, td) = (
+            m(&j.proximal) * Vector3::from(np),
+            m(&j.distal) * Vector3::from(nd),
+        );
         let worst = |f: &dyn Fn(&acm_workbench::acm::hinge::HingeWindow) -> Option<f64>| {
             rec.windows.iter().filter_map(f).fold(0.0, f64::max)
         };
-        let ep = worst(&|w| w.proximal_axis.map(|a| angle_between_axes_deg(&a.into(), &tp)));
-        let ed = worst(&|w| w.distal_axis.map(|b| angle_between_axes_deg(&b.into(), &td)));
+        let ep = worst(&|w| {
+            w.proximal_axis
+                .map(|a| angle_between_axes_deg(&a.into(), &tp))
+        });
+        let ed = worst(&|w| {
+            w.distal_axis
+                .map(|b| angle_between_axes_deg(&b.into(), &td))
+        });
         let rms = |t: &Trial| {
             let a = acm_workbench::metrics::joint_angles(t, j).unwrap();
             let tr = acm_workbench::metrics::joint_angles(&sim.truth.segments, j).unwrap();
@@ -216,14 +236,23 @@ fn the_upper_joint_s_correction_keeps_the_axis_of_the_hinge_below() {
     }
 }
 
-
 #[test]
 fn the_command_line_writes_the_axes_into_the_sidecar_and_the_report() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let sim = [
-        "simulate", "knee", "--imu", "thigh", "--axis", "z", "--angle", "20", "--duration",
-        "120", "-o", "k.csv",
+        "simulate",
+        "knee",
+        "--imu",
+        "thigh",
+        "--axis",
+        "z",
+        "--angle",
+        "20",
+        "--duration",
+        "120",
+        "-o",
+        "k.csv",
     ];
     common::acmw_ok(d, &sim);
     common::acmw_ok(d, &["correct", "k.csv", "--variant", "hinge", "--quiet"]);
@@ -238,11 +267,20 @@ fn the_command_line_writes_the_axes_into_the_sidecar_and_the_report() {
     assert_eq!(h["proximal_turned_by_axis"], true);
     let w = &h["windows"][0];
     // The thigh sits 20 deg about Z off the hinge: its axis is tilted by that.
-    assert!((w["proximal_tilt_deg"].as_f64().unwrap() - 20.0).abs() < 0.1, "{w}");
+    assert!(
+        (w["proximal_tilt_deg"].as_f64().unwrap() - 20.0).abs() < 0.1,
+        "{w}"
+    );
     assert!(w["distal_tilt_deg"].as_f64().unwrap() < 0.1, "{w}");
     let out = common::ok(&common::acmw(d, &["report", "k.csv", "--variant", "hinge"]));
     assert!(out.contains("Hinge axes, hinge"), "{out}");
-    let line = out.lines().find(|l| l.starts_with("l_knee ") && l.contains("hinge y")).unwrap();
-    assert!(line.contains("3/3 | 3/3 windows; tilt 20.00 | 0.00"), "{line}");
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("l_knee ") && l.contains("hinge y"))
+        .unwrap();
+    assert!(
+        line.contains("3/3 | 3/3 windows; tilt 20.00 | 0.00"),
+        "{line}"
+    );
     assert!(line.contains("turned by the axis alone"), "{line}");
 }

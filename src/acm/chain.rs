@@ -164,7 +164,15 @@ fn run(
         let level: Vec<&(usize, JointLimits)> =
             todo.iter().filter(|(k, _)| depths[*k] == depth).collect();
         for (k, _) in &level {
-            turn_uncorrected_proximal(&mut corrected, trial, model, &todo, *k, &mut hinges, &windows);
+            turn_uncorrected_proximal(
+                &mut corrected,
+                trial,
+                model,
+                &todo,
+                *k,
+                &mut hinges,
+                &windows,
+            );
         }
         let solved: Vec<(usize, JointResult, Applied, Option<ImuHeading>)> = level
             .par_iter()
@@ -484,9 +492,8 @@ fn solve_windows_with_axes(
             }
             let cost = WindowCost::new(&measured[w.first..w.end], limits, lambda1);
             // The size term counts the turn about the axis only (see `hinge`).
-            let about_axis = |c: &Quat, phi: f64| {
-                cost.eval(c) - lambda1 * angle_deg(c) + lambda1 * phi.abs()
-            };
+            let about_axis =
+                |c: &Quat, phi: f64| cost.eval(c) - lambda1 * angle_deg(c) + lambda1 * phi.abs();
             let s = hinge::minimise_about_axis(&about_axis, family);
             if free.is_none() {
                 progress();

@@ -356,10 +356,7 @@ pub struct AxisSolution {
 /// of `phi` over the whole turn at 2 deg steps, then a golden-section search
 /// in the steps either side of the best (the first best on ties, so the
 /// result is deterministic).
-pub fn minimise_about_axis(
-    cost: &dyn Fn(&Quat, f64) -> f64,
-    family: &AxisFamily,
-) -> AxisSolution {
+pub fn minimise_about_axis(cost: &dyn Fn(&Quat, f64) -> f64, family: &AxisFamily) -> AxisSolution {
     let steps = (360.0 / SCAN_STEP_DEG).round() as usize;
     let f = |phi: f64| cost(&family.at(phi), wrap180(phi));
     let mut best = (0.0, f(0.0));
