@@ -14,6 +14,7 @@
 //! the joint's three rows. The global settings (`lambda1`, window and hop) live in
 //! `joint_limits/settings.toml` (see [`Settings`]).
 
+use crate::acm::minimise::Solver;
 use crate::model::Model;
 use crate::vertical::Vertical;
 use serde::{Deserialize, Serialize};
@@ -105,6 +106,10 @@ pub struct Settings {
     /// The global frame's up axis (heading-drift variants turn about it).
     #[serde(default)]
     pub vertical: Vertical,
+    /// The minimiser of the window costs (the previous one stays selectable,
+    /// to compare against).
+    #[serde(default, skip_serializing_if = "Solver::is_default")]
+    pub solver: Solver,
 }
 
 impl Default for Settings {
@@ -114,6 +119,7 @@ impl Default for Settings {
             window_s: 60.0,
             hop_s: 30.0,
             vertical: Vertical::ZUp,
+            solver: Solver::default(),
         }
     }
 }
@@ -176,6 +182,7 @@ impl SettingsFile {
             window_s: self.window_s,
             hop_s: self.hop_s,
             vertical: self.vertical,
+            solver: Solver::default(),
         }
     }
 

@@ -272,5 +272,7 @@ pub fn calibrate(
     ))
 }
 
+pub mod convention;
+
 #[cfg(test)]
 mod tests;

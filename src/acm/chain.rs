@@ -19,7 +19,9 @@ use super::cost::WindowCost;
 use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
 use super::hinge::{self, AxisFamily, HingeFits};
 use super::lookahead::{ChildJoint, Lookahead};
-use super::minimise::{minimise, MinimiseOptions, Solution};
+use super::minimise::{
+    minimise, minimise_shaped, MinimiseOptions, ShapedCost, ShapedOptions, Solution, Solver,
+};
 use super::window::{correction_series, layout, whole_trial, Window};
 use super::{
     Cancelled, Correction, HeadingWindow, ImuHeading, JointResult, RunControl, SkippedJoint,
@@ -52,10 +54,39 @@ pub fn correct_trial(
     variant: Variant,
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
-    if variant == Variant::Ik {
-        return crate::ik::correct_trial(trial, model, settings, control);
+    match variant {
+        Variant::Ik => crate::ik::correct_trial(trial, model, settings, control),
+        Variant::None => Ok(uncorrected(trial, model, limits, settings)),
+        _ => run(trial, model, limits, settings, variant, None, control),
     }
-    run(trial, model, limits, settings, variant, None, control)
+}
+
+/// The `none` variant: the trial as it is, every joint left uncorrected (the
+/// joints that could not be corrected in any variant are listed as skipped).
+fn uncorrected(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    settings: &Settings,
+) -> Correction {
+    Correction {
+        headings: Vec::new(),
+        variant: Variant::None,
+        settings: *settings,
+        corrected: trial.clone(),
+        joints: Vec::new(),
+        skipped: model
+            .joints
+            .iter()
+            .filter_map(|j| {
+                skip_reason(trial, j, limits).map(|reason| SkippedJoint {
+                    joint: j.name.clone(),
+                    reason,
+                })
+            })
+            .collect(),
+        ik: None,
+    }
 }
 
 /// Re-corrects the named joints and everything below them, reusing `previous`
@@ -72,8 +103,9 @@ pub fn recorrect(
     joints: &[&str],
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
-    if previous.variant == Variant::Ik {
-        // Inverse kinematics does not read the limit table or the settings.
+    if matches!(previous.variant, Variant::Ik | Variant::None) {
+        // Inverse kinematics and no correction do not read the limit table
+        // or the settings.
         return Ok(previous.clone());
     }
     let mut redo = BTreeSet::new();
@@ -275,8 +307,7 @@ fn run(
                     Some(f) => solve_windows_with_axes(
                         (&trial.time_s, &measured),
                         &windows,
-                        lim,
-                        settings.lambda1,
+                        (lim, settings.lambda1, settings.solver),
                         &f.per_window,
                         control,
                         &progress,
@@ -285,8 +316,7 @@ fn run(
                         &trial.time_s,
                         &measured,
                         &windows,
-                        lim,
-                        settings.lambda1,
+                        (lim, settings.lambda1, settings.solver),
                         control,
                         &progress,
                     )?,
@@ -469,15 +499,19 @@ fn turn_uncorrected_proximal(
 fn solve_windows_with_axes(
     (time_s, measured): (&[f64], &[Quat]),
     windows: &[Window],
-    limits: &JointLimits,
-    lambda1: f64,
+    (limits, lambda1, solver): (&JointLimits, f64, Solver),
     families: &[Option<AxisFamily>],
     control: &RunControl,
     progress: &(dyn Fn() + Sync),
 ) -> Result<JointSolution, Cancelled> {
     let free = if families.iter().any(Option::is_none) {
         Some(solve_windows(
-            time_s, measured, windows, limits, lambda1, control, progress,
+            time_s,
+            measured,
+            windows,
+            (limits, lambda1, solver),
+            control,
+            progress,
         )?)
     } else {
         None
@@ -632,28 +666,59 @@ pub fn correct_joint(
     limits: &JointLimits,
     lambda1: f64,
 ) -> JointSolution {
-    solve_windows(
+    correct_joint_with(
         time_s,
         measured,
         windows,
         limits,
         lambda1,
+        Solver::default(),
+    )
+}
+
+/// As [`correct_joint`], with the given minimiser.
+pub fn correct_joint_with(
+    time_s: &[f64],
+    measured: &[Quat],
+    windows: &[Window],
+    limits: &JointLimits,
+    lambda1: f64,
+    solver: Solver,
+) -> JointSolution {
+    solve_windows(
+        time_s,
+        measured,
+        windows,
+        (limits, lambda1, solver),
         &RunControl::default(),
         &|| {},
     )
     .expect("no cancel flag")
 }
 
+/// Minimises one window's cost from `starts` with `solver`.
+pub fn solve_window(cost: &WindowCost, starts: &[Quat], solver: Solver) -> Solution {
+    match solver {
+        Solver::NelderMead => minimise(&|c| cost.eval(c), starts, &MinimiseOptions::default()),
+        Solver::Gradient => {
+            let data = |c: &Quat| cost.data_grad(c);
+            let shaped = ShapedCost {
+                data: &data,
+                cone: cost.lambda1(),
+            };
+            minimise_shaped(&shaped, starts, &ShapedOptions::default())
+        }
+    }
+}
+
 fn solve_windows(
     time_s: &[f64],
     measured: &[Quat],
     windows: &[Window],
-    limits: &JointLimits,
-    lambda1: f64,
+    (limits, lambda1, solver): (&JointLimits, f64, Solver),
     control: &RunControl,
     progress: &(dyn Fn() + Sync),
 ) -> Result<JointSolution, Cancelled> {
-    let opts = MinimiseOptions::default();
     let costs: Vec<WindowCost> = windows
         .iter()
         .map(|w| WindowCost::new(&measured[w.first..w.end], limits, lambda1))
@@ -665,7 +730,7 @@ fn solve_windows(
             if control.cancelled() {
                 return Err(Cancelled);
             }
-            let s = minimise(&|c| cost.eval(c), &[Quat::identity()], &opts);
+            let s = solve_window(cost, &[Quat::identity()], solver);
             progress();
             Ok(s)
         })
@@ -684,7 +749,7 @@ fn solve_windows(
             if neighbours.is_empty() {
                 return first[k];
             }
-            let s = minimise(&|c| cost.eval(c), &neighbours, &opts);
+            let s = solve_window(cost, &neighbours, solver);
             if s.cost < first[k].cost {
                 Solution {
                     evaluations: s.evaluations + first[k].evaluations,

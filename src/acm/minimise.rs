@@ -1,16 +1,46 @@
 //! Minimising the ACM cost over rotations.
 //!
-//! The cost is piecewise smooth with kinks (excursions switch on and off, the
-//! `lambda1 * angle(C)` term has a cone at identity) and flat regions, so the
-//! minimiser uses no gradients: Nelder-Mead over a rotation vector `v` (radians)
-//! in the tangent space of a reference rotation, `C = C_ref * exp(v)`. The
-//! reference is moved to the best point at every restart, so the
-//! parameterisation never nears its singularity. A restart with a fresh simplex
-//! follows every convergence until it no longer lowers the cost, which takes
-//! care of simplices that collapse on a kink.
+//! Two minimisers, both over a rotation vector `v` (radians) in the tangent
+//! space of a reference rotation, `C = C_ref * exp(v)`; the reference is moved
+//! to the best point at every restart, so the parameterisation never nears its
+//! singularity, and a restart follows every convergence until it no longer
+//! lowers the cost.
+//!
+//! - [`minimise_shaped`] (the default, [`Solver::Gradient`]) knows the cost's
+//!   shape, [`ShapedCost`]: a piecewise smooth part whose value and gradient
+//!   come in one pass, plus `w * angle(C)`, a cone at identity it handles
+//!   itself. Quasi-Newton (BFGS) steps with a weak Wolfe line search, which
+//!   converge on kinks too (the model's curvature grows across them); at the
+//!   cone's tip it steps along the least subgradient, or stops there when that
+//!   is zero (the tip is then a minimum).
+//! - [`minimise`] ([`Solver::NelderMead`]) uses values only: Nelder-Mead, the
+//!   previous solver, kept selectable and as the oracle the gradient solver
+//!   is tested against; the heading variants' C steps still use it.
 
-use crate::rotation::{quat_from_rotvec, Quat};
-use nalgebra::Vector3;
+use crate::rotation::{angle_deg, quat_from_rotvec, Quat};
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Which minimiser solves the ACM's window costs.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Solver {
+    /// Value and gradient in one pass, quasi-Newton steps ([`minimise_shaped`]).
+    #[default]
+    Gradient,
+    /// Nelder-Mead with restarts on values only ([`minimise`]): the previous
+    /// solver, kept as the reference.
+    NelderMead,
+}
+
+impl Solver {
+    /// True for the default solver (settings files leave it out).
+    pub fn is_default(&self) -> bool {
+        *self == Solver::default()
+    }
+}
 
 /// Tuning of the minimiser.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -163,6 +193,246 @@ fn descend(
     simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
     let (v, fv) = simplex[0];
     (at(&v), fv, evals.get())
+}
+
+/// A cost of the shape [`minimise_shaped`] assumes:
+/// `f(C) = data(C) + cone * angle_deg(C)`, with `data` continuous and
+/// piecewise smooth (kinks where a sample crosses a limit allowed) and
+/// `cone >= 0`.
+pub struct ShapedCost<'a> {
+    /// `data(C)` and its gradient with respect to `v` in `C * exp(v)` at
+    /// `v = 0` (per radian).
+    pub data: &'a dyn Fn(&Quat) -> (f64, Vector3<f64>),
+    /// Weight of `angle_deg(C)`.
+    pub cone: f64,
+}
+
+impl ShapedCost<'_> {
+    /// `f(C)` and a gradient in the tangent at `C`: the cone's at `C != I`;
+    /// at `C = I` the least-norm subgradient (zero when the tip is a minimum).
+    fn at(&self, c: &Quat) -> (f64, Vector3<f64>) {
+        let (f, g) = (self.data)(c);
+        let angle = angle_deg(c);
+        let w = self.cone * DEG;
+        let axis = Vector3::new(c.i, c.j, c.k) * c.w.signum();
+        let norm = axis.norm();
+        let cone_grad = if norm > 0.0 {
+            axis * (w / norm)
+        } else {
+            let gn = g.norm();
+            return (
+                f,
+                if gn > w {
+                    g * (1.0 - w / gn)
+                } else {
+                    Vector3::zeros()
+                },
+            );
+        };
+        (f + self.cone * angle, g + cone_grad)
+    }
+}
+
+/// Degrees per radian.
+const DEG: f64 = 180.0 / std::f64::consts::PI;
+
+/// The right Jacobian of `exp` at `v`: `exp(v + dv) = exp(v) exp(J_r(v) dv)`.
+fn right_jacobian(v: &Vector3<f64>) -> Matrix3<f64> {
+    let t = v.norm();
+    let k = v.cross_matrix();
+    let (a, b) = if t < 1e-4 {
+        (0.5 - t * t / 24.0, 1.0 / 6.0 - t * t / 120.0)
+    } else {
+        ((1.0 - t.cos()) / (t * t), (t - t.sin()) / (t * t * t))
+    };
+    Matrix3::identity() - k * a + k * k * b
+}
+
+/// Tuning of [`minimise_shaped`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapedOptions {
+    /// Length of the first step, radians.
+    pub initial_step_rad: f64,
+    /// The longest step, radians.
+    pub max_step_rad: f64,
+    /// A step shorter than this ends a descent, radians.
+    pub tol_x_rad: f64,
+    /// Three steps that together gain less than this fraction of the cost
+    /// end a descent.
+    pub tol_f_rel: f64,
+    /// A restart that gains less than this ends the search.
+    pub min_gain: f64,
+    /// Most restarts after the first descent.
+    pub max_restarts: usize,
+    /// Most quasi-Newton iterations of one descent.
+    pub max_iterations: usize,
+    /// Most evaluations of one line search.
+    pub max_line_evals: usize,
+}
+
+impl Default for ShapedOptions {
+    fn default() -> Self {
+        ShapedOptions {
+            initial_step_rad: 0.05,
+            max_step_rad: 0.5,
+            tol_x_rad: 1e-9,
+            tol_f_rel: 1e-10,
+            min_gain: 1e-12,
+            max_restarts: 0,
+            max_iterations: 200,
+            max_line_evals: 40,
+        }
+    }
+}
+
+/// Minimises a cost of the shape [`ShapedCost`] from each of `starts` (at
+/// least one), keeping the best; restarts (a fresh curvature model at the
+/// best point) follow until one gains less than `min_gain`.
+///
+/// Deterministic: the same starts and cost give the same result.
+pub fn minimise_shaped(cost: &ShapedCost, starts: &[Quat], opts: &ShapedOptions) -> Solution {
+    assert!(!starts.is_empty(), "minimise needs a start");
+    let mut evaluations = 0;
+    let mut best: Option<(Quat, f64)> = None;
+    for s in starts {
+        let (c, f, n) = quasi_newton(cost, s, opts);
+        evaluations += n;
+        if best.is_none_or(|(_, bf)| f < bf) {
+            best = Some((c, f));
+        }
+    }
+    let (mut c, mut f) = best.expect("at least one start");
+    for _ in 0..opts.max_restarts {
+        let (c2, f2, n) = quasi_newton(cost, &c, opts);
+        evaluations += n;
+        let gain = f - f2;
+        if gain > 0.0 {
+            c = c2;
+            f = f2;
+        }
+        if gain < opts.min_gain {
+            break;
+        }
+    }
+    Solution {
+        c,
+        cost: f,
+        evaluations,
+    }
+}
+
+/// One BFGS descent from `base` over `v` in `base * exp(v)`. Returns the best
+/// rotation, its cost and the evaluations spent.
+fn quasi_newton(cost: &ShapedCost, base: &Quat, opts: &ShapedOptions) -> (Quat, f64, usize) {
+    let mut evals = 0usize;
+    let mut eval = |v: &Vector3<f64>| {
+        evals += 1;
+        let (f, g) = cost.at(&(base * quat_from_rotvec(v)));
+        (f, right_jacobian(v).transpose() * g)
+    };
+    let mut x = Vector3::zeros();
+    let (mut f, mut g) = eval(&x);
+    let mut h: Option<Matrix3<f64>> = None;
+    // Length of the steepest-descent trial step: the first step's, then the
+    // last accepted step's (near a kink the right scale is the recent one).
+    let mut scale = opts.initial_step_rad;
+    let mut gains = [f64::INFINITY; 3];
+    for iteration in 0..opts.max_iterations {
+        let gn = g.norm();
+        if gn == 0.0 || !gn.is_finite() {
+            break;
+        }
+        let mut d = match &h {
+            Some(h) => -(h * g),
+            None => -g * (scale / gn),
+        };
+        if d.dot(&g) >= 0.0 {
+            h = None;
+            d = -g * (scale / gn);
+        }
+        let len = d.norm();
+        if len > opts.max_step_rad {
+            d *= opts.max_step_rad / len;
+        }
+        let line = Line {
+            max_evals: opts.max_line_evals,
+            min_step_rad: opts.tol_x_rad,
+        };
+        let Some((t, ft, gt)) = wolfe(&mut eval, (&x, f, &g), &d, &line) else {
+            if h.is_some() {
+                // The model misled the step: try once more along the gradient.
+                h = None;
+                continue;
+            }
+            break;
+        };
+        let s = d * t;
+        let y = gt - g;
+        x += s;
+        gains[iteration % 3] = f - ft;
+        f = ft;
+        g = gt;
+        scale = s.norm().max(opts.tol_x_rad);
+        let sy = s.dot(&y);
+        if sy > 1e-300 {
+            let h0 = h.unwrap_or_else(|| Matrix3::identity() * (sy / y.dot(&y)));
+            let rho = 1.0 / sy;
+            let i = Matrix3::identity();
+            let a = i - s * y.transpose() * rho;
+            h = Some(a * h0 * a.transpose() + s * s.transpose() * rho);
+        }
+        let recent: f64 = gains.iter().sum();
+        if s.amax() < opts.tol_x_rad || recent <= opts.tol_f_rel * f.abs() + 1e-15 {
+            break;
+        }
+    }
+    (base * quat_from_rotvec(&x), f, evals)
+}
+
+/// Limits of one line search.
+struct Line {
+    max_evals: usize,
+    /// A bracket narrower than this (radians) ends the search.
+    min_step_rad: f64,
+}
+
+/// A weak Wolfe line search along `d` from `x` (value `f`, gradient `g`):
+/// the step `t` and the value and gradient there, or none when no step
+/// lowers the cost. Bisects on a bracket, doubles without one.
+fn wolfe(
+    eval: &mut impl FnMut(&Vector3<f64>) -> (f64, Vector3<f64>),
+    (x, f, g): (&Vector3<f64>, f64, &Vector3<f64>),
+    d: &Vector3<f64>,
+    line: &Line,
+) -> Option<(f64, f64, Vector3<f64>)> {
+    const C1: f64 = 1e-4;
+    const C2: f64 = 0.9;
+    let slope = g.dot(d);
+    let (mut lo, mut hi) = (0.0, f64::INFINITY);
+    let mut t = 1.0;
+    let mut best: Option<(f64, f64, Vector3<f64>)> = None;
+    for _ in 0..line.max_evals {
+        let (ft, gt) = eval(&(x + d * t));
+        if ft < f && best.as_ref().is_none_or(|b| ft < b.1) {
+            best = Some((t, ft, gt));
+        }
+        if ft > f + C1 * t * slope || !ft.is_finite() {
+            hi = t;
+        } else if gt.dot(d) < C2 * slope {
+            lo = t;
+        } else {
+            return Some((t, ft, gt));
+        }
+        t = if hi.is_finite() {
+            0.5 * (lo + hi)
+        } else {
+            2.0 * lo
+        };
+        if hi.is_finite() && (hi - lo) * d.amax() < line.min_step_rad {
+            break;
+        }
+    }
+    best
 }
 
 #[cfg(test)]

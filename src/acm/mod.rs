@@ -18,7 +18,7 @@ pub mod minimise;
 pub mod parent_cost;
 pub mod window;
 
-pub use chain::{correct_joint, correct_trial, recorrect};
+pub use chain::{correct_joint, correct_joint_with, correct_trial, recorrect, solve_window};
 
 use crate::limits::Settings;
 use crate::trial::Trial;
@@ -64,11 +64,14 @@ pub enum Variant {
     /// estimated in both IMUs' frames ([`hinge`]): they fix two degrees of
     /// freedom of the distal IMU's correction and of the proximal one's.
     Hinge,
+    /// No correction: the trial as read, after any pose or functional
+    /// calibration (the step before every other variant).
+    None,
 }
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 9] = [
+    pub const ALL: [Variant; 10] = [
         Variant::Basic,
         Variant::Drift,
         Variant::DriftCentroid,
@@ -78,6 +81,7 @@ impl Variant {
         Variant::Mueller,
         Variant::Ik,
         Variant::Hinge,
+        Variant::None,
     ];
 
     /// The name used on the command line, in files and on screen.
@@ -92,6 +96,7 @@ impl Variant {
             Variant::DriftHeadingCentroid => "drift-heading-centroid",
             Variant::Ik => "ik",
             Variant::Hinge => "hinge",
+            Variant::None => "none",
         }
     }
 
@@ -102,7 +107,7 @@ impl Variant {
 
     /// Solves per window (true) or once for the whole trial (false).
     pub fn windowed(self) -> bool {
-        !matches!(self, Variant::Basic | Variant::Ik)
+        !matches!(self, Variant::Basic | Variant::Ik | Variant::None)
     }
 
     /// Uses the table's centroid term.

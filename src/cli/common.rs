@@ -34,6 +34,10 @@ pub struct EngineArgs {
     /// recordings [default: from ./joint_limits/settings.toml, else z-up].
     #[arg(long)]
     pub vertical: Option<acm_workbench::vertical::Vertical>,
+    /// Minimiser of the window costs: `gradient`, or `nelder-mead` (the
+    /// previous solver, values only, slower) [default: gradient].
+    #[arg(long)]
+    pub solver: Option<acm_workbench::acm::minimise::Solver>,
     /// Worker threads [default: all cores]; results do not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -49,7 +53,12 @@ pub struct PoseArgs {
     pub pose_calibration: Option<PoseTime>,
     /// The base IMU's sensor axis that points forward in the calibration pose
     /// (+x, -x, +y, -y, +z, -z) [default: the model's `pose.base_forward`].
-    #[arg(long, value_name = "AXIS", requires = "pose_calibration")]
+    #[arg(
+        long,
+        value_name = "AXIS",
+        requires = "pose_calibration",
+        allow_hyphen_values = true
+    )]
     pub base_forward: Option<SignedAxis>,
 }
 
@@ -133,6 +142,7 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
         window_s: args.window.unwrap_or(defaults.window_s),
         hop_s: args.hop.unwrap_or(defaults.hop_s),
         vertical: args.vertical.unwrap_or(defaults.vertical),
+        solver: args.solver.unwrap_or(defaults.solver),
     };
     settings.validate("command line")?;
     Ok(Context {

@@ -77,6 +77,10 @@ pub struct Trial {
 }
 
 /// The file formats a trial can be read from and written to.
+/// Every input the trial readers accept, in one phrase (for errors; the help
+/// texts say the same).
+pub const ACCEPTED_INPUTS: &str = "a canonical CSV (time,<imu>_qw,_qx,_qy,_qz,...), an Euler CSV (time,<imu>_roll,_pitch,_yaw,...) or an OpenSim .sto, each optionally .gz; an Xsens MT Manager export (.txt or .csv, tab, comma or semicolon separated; one IMU); a folder of such exports; or an OpenSense mapping .xml";
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum TrialFormat {
