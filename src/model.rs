@@ -177,6 +177,61 @@ fn is_all_axes(v: &[Axis]) -> bool {
     v == Axis::ALL
 }
 
+/// How a hinge joint turns, in its Z-Y-X angles (docs/method.md section 18):
+/// the axes the `hinge` variant estimates in both IMUs' frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum Hinge {
+    /// One axis, fixed in both segments (`"y"` for a knee: flexion only).
+    Single(Axis),
+    /// Two axes: Z fixed in the proximal segment and X in the distal one, the
+    /// Y angle constant (`"z-x"` for an elbow: pronation and flexion).
+    ZX,
+}
+
+impl Hinge {
+    /// The hinge axis in the proximal and in the distal segment frame (unit).
+    pub fn segment_axes(self) -> ([f64; 3], [f64; 3]) {
+        match self {
+            Hinge::Single(a) => {
+                let mut v = [0.0; 3];
+                v[a.index()] = 1.0;
+                (v, v)
+            }
+            Hinge::ZX => ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+        }
+    }
+
+    /// The name in model files: `x`, `y`, `z` or `z-x`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Hinge::Single(a) => a.name(),
+            Hinge::ZX => "z-x",
+        }
+    }
+}
+
+impl TryFrom<String> for Hinge {
+    type Error = String;
+    fn try_from(s: String) -> Result<Hinge, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "x" => Ok(Hinge::Single(Axis::X)),
+            "y" => Ok(Hinge::Single(Axis::Y)),
+            "z" => Ok(Hinge::Single(Axis::Z)),
+            "z-x" => Ok(Hinge::ZX),
+            _ => Err(format!(
+                "hinge = '{s}': expected x, y or z (one axis fixed in both segments) or z-x (Z fixed in the proximal segment, X in the distal)"
+            )),
+        }
+    }
+}
+
+impl From<Hinge> for String {
+    fn from(h: Hinge) -> String {
+        h.name().to_string()
+    }
+}
+
 /// One joint: the rotation of the distal IMU relative to the proximal one.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Joint {
@@ -201,6 +256,11 @@ pub struct Joint {
     /// degrees (pose calibration takes the IMUs to show this pose).
     #[serde(default, skip_serializing_if = "is_default")]
     pub default_pose_deg: [f64; 3],
+    /// Marks a hinge joint: the `hinge` variant estimates these axes in both
+    /// IMUs' frames and corrects the proximal IMU with them too. Absent: not a
+    /// hinge.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hinge: Option<Hinge>,
 }
 
 impl Joint {

@@ -1,6 +1,7 @@
 //! A trial's figures before and after each correction variant, as a data
 //! structure (for JSON and screens) and as aligned text tables (for terminals).
 
+use crate::acm::hinge::HingeRecord;
 use crate::acm::window::{borrow_notes, layout};
 use crate::acm::{
     correct_trial, Cancelled, Correction, ImuHeading, RunControl, SkippedJoint, Variant,
@@ -28,6 +29,9 @@ pub struct VariantReport {
     /// The `ik` variant's solver figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ik: Option<IkSummary>,
+    /// The hinge axes per hinge joint (`hinge` variant only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hinges: Vec<(String, HingeRecord)>,
 }
 
 /// A trial's figures, uncorrected and per variant.
@@ -117,6 +121,9 @@ impl ReportInput<'_> {
                     skipped: c.skipped.clone(),
                     headings: c.headings.clone(),
                     ik: c.ik.as_ref().map(|r| r.summary()),
+                    hinges: (c.joints.iter())
+                        .filter_map(|j| j.hinge.clone().map(|h| (j.joint.clone(), h)))
+                        .collect(),
                 })
                 .collect(),
             warnings: t.warnings.clone(),
@@ -367,12 +374,58 @@ pub fn format_text(r: &TrialReport) -> String {
     for v in r.variants.iter().filter(|v| v.variant.heading()) {
         heading_table(&mut out, v);
     }
+    for v in r.variants.iter().filter(|v| !v.hinges.is_empty()) {
+        hinge_text(&mut out, v);
+    }
     for v in &r.variants {
         if let Some(ik) = &v.ik {
             ik_text(&mut out, ik);
         }
     }
     out
+}
+
+/// Per hinge joint: in how many windows each axis was used, how far the
+/// sensors sat off the hinge, and why a window fell back.
+fn hinge_text(out: &mut String, v: &VariantReport) {
+    let _ = writeln!(
+        out,
+        "\nHinge axes, {}: windows using the proximal | distal axis; mean tilt of each from the IMU's own axis, deg",
+        v.variant
+    );
+    for (joint, h) in &v.hinges {
+        let (p, d) = h.windows_used();
+        let mean = |f: &dyn Fn(&crate::acm::hinge::HingeWindow) -> Option<f64>| {
+            let xs: Vec<f64> = h.windows.iter().filter_map(f).collect();
+            if xs.is_empty() {
+                "-".to_string()
+            } else {
+                format!("{:.2}", xs.iter().sum::<f64>() / xs.len() as f64)
+            }
+        };
+        let n = h.windows.len();
+        let _ = writeln!(
+            out,
+            "{joint:<14} hinge {:<4} {p}/{n} | {d}/{n} windows; tilt {} | {}{}",
+            h.hinge,
+            mean(&|w| w.proximal_tilt_deg),
+            mean(&|w| w.distal_tilt_deg),
+            if h.proximal_turned_by_axis {
+                "; proximal IMU turned by the axis alone (no joint above corrects it)"
+            } else {
+                ""
+            }
+        );
+        for w in &h.windows {
+            if let Some(why) = &w.fallback {
+                let _ = writeln!(
+                    out,
+                    "{:14} window at {:.1} s, axis not used (drift-centroid there): {why}",
+                    "", w.centre_s
+                );
+            }
+        }
+    }
 }
 
 fn ik_text(out: &mut String, s: &IkSummary) {

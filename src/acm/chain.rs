@@ -17,6 +17,7 @@
 
 use super::cost::WindowCost;
 use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
+use super::hinge::{self, AxisFamily, HingeFits};
 use super::lookahead::{ChildJoint, Lookahead};
 use super::minimise::{
     minimise, minimise_shaped, MinimiseOptions, ShapedCost, ShapedOptions, Solution, Solver,
@@ -180,6 +181,7 @@ fn run(
             }
         }
     }
+    let mut hinges = hinge_fits(trial, model, &todo, variant, &windows);
     let solve_count = todo
         .iter()
         .filter(|(k, _)| reuse.is_none_or(|(_, redo)| redo.contains(k)))
@@ -193,6 +195,17 @@ fn run(
     for depth in 0..=max_depth {
         let level: Vec<&(usize, JointLimits)> =
             todo.iter().filter(|(k, _)| depths[*k] == depth).collect();
+        for (k, _) in &level {
+            turn_uncorrected_proximal(
+                &mut corrected,
+                trial,
+                model,
+                &todo,
+                *k,
+                &mut hinges,
+                &windows,
+            );
+        }
         let solved: Vec<(usize, JointResult, Applied, Option<ImuHeading>)> = level
             .par_iter()
             .map(|(k, lim)| {
@@ -219,6 +232,7 @@ fn run(
                         p(d, total);
                     }
                 };
+                let families = axis_families(model, &todo, &hinges, *k);
                 let result = |windows, baseline| JointResult {
                     joint: joint.name.clone(),
                     proximal: joint.proximal.clone(),
@@ -227,6 +241,8 @@ fn run(
                     parent_corrected,
                     windows,
                     baseline,
+                    hinge: hinges.get(k).map(|f| f.record.clone()),
+                    axis_from: families.as_ref().and_then(|f| f.from_child.clone()),
                 };
                 if variant.heading() {
                     if control.cancelled() {
@@ -287,14 +303,24 @@ fn run(
                     let applied = Applied::Series(sol.series, GyroUpdate::Replace(gyro));
                     return Ok((*k, result(sol.windows, baseline), applied, None));
                 }
-                let sol = solve_windows(
-                    &trial.time_s,
-                    &measured,
-                    &windows,
-                    (lim, settings.lambda1, settings.solver),
-                    control,
-                    &progress,
-                )?;
+                let sol = match &families {
+                    Some(f) => solve_windows_with_axes(
+                        (&trial.time_s, &measured),
+                        &windows,
+                        (lim, settings.lambda1, settings.solver),
+                        &f.per_window,
+                        control,
+                        &progress,
+                    )?,
+                    None => solve_windows(
+                        &trial.time_s,
+                        &measured,
+                        &windows,
+                        (lim, settings.lambda1, settings.solver),
+                        control,
+                        &progress,
+                    )?,
+                };
                 let applied = Applied::Series(sol.series, GyroUpdate::Turn);
                 Ok((*k, result(sol.windows, None), applied, None))
             })
@@ -340,6 +366,193 @@ fn run(
         joints: joints.into_iter().map(|(_, r)| r).collect(),
         skipped,
         ik: None,
+    })
+}
+
+/// The hinge joints' axes per window (the `hinge` variant; empty otherwise),
+/// estimated from the raw trial: each IMU's axis is in its own sensor frame,
+/// which its corrections start from.
+fn hinge_fits(
+    trial: &Trial,
+    model: &Model,
+    todo: &[(usize, JointLimits)],
+    variant: Variant,
+    windows: &[Window],
+) -> HashMap<usize, HingeFits> {
+    if !variant.hinge() {
+        return HashMap::new();
+    }
+    let fits: Vec<(usize, HingeFits)> = todo
+        .par_iter()
+        .filter_map(|(k, _)| {
+            let joint = &model.joints[*k];
+            let h = joint.hinge?;
+            let p = trial.imu(&joint.proximal)?;
+            let d = trial.imu(&joint.distal)?;
+            let rm: Vec<Quat> = (p.orientation.iter().zip(&d.orientation))
+                .map(|(p, d)| p.inverse() * d)
+                .collect();
+            let gyros = match (&p.gyro, &d.gyro) {
+                (Some(proximal), Some(distal)) => Some(baselines::JointGyros { proximal, distal }),
+                _ => None,
+            };
+            let fits = hinge::estimate_windows(h, &trial.time_s, &rm, gyros, windows);
+            Some((*k, fits))
+        })
+        .collect();
+    fits.into_iter().collect()
+}
+
+/// Where a joint's distal IMU has a hinge axis, the family of corrections
+/// that keep it per window: the joint's own distal axis first, else the
+/// proximal axis of a hinge joint below it (named in `from_child`).
+struct Families {
+    per_window: Vec<Option<AxisFamily>>,
+    from_child: Option<String>,
+}
+
+fn axis_families(
+    model: &Model,
+    todo: &[(usize, JointLimits)],
+    hinges: &HashMap<usize, HingeFits>,
+    k: usize,
+) -> Option<Families> {
+    let own = hinges.get(&k);
+    let child = todo
+        .iter()
+        .map(|(c, _)| *c)
+        .find(|c| model.joints[*c].proximal == model.joints[k].distal && hinges.contains_key(c));
+    let child_fits = child.and_then(|c| hinges.get(&c));
+    let windows = own.or(child_fits)?.axes.len();
+    let mut from_child = false;
+    let per_window: Vec<Option<AxisFamily>> = (0..windows)
+        .map(|w| {
+            let mine = own.and_then(|f| {
+                let nd = Vector3::from(f.hinge.segment_axes().1);
+                f.axes[w].distal.map(|b| AxisFamily::new(&nd, &b))
+            });
+            mine.or_else(|| {
+                let f = child_fits?;
+                let np = Vector3::from(f.hinge.segment_axes().0);
+                let fam = f.axes[w].proximal.map(|a| AxisFamily::new(&np, &a));
+                from_child |= fam.is_some();
+                fam
+            })
+        })
+        .collect();
+    if per_window.iter().all(Option::is_none) {
+        return None;
+    }
+    Some(Families {
+        per_window,
+        from_child: from_child.then(|| model.joints[child.expect("found")].name.clone()),
+    })
+}
+
+/// Turns the proximal IMU of hinge joint `k` by its axis alone when no joint
+/// above corrects it (and it is not the base): per window the least rotation
+/// taking the segment axis onto the estimated one, slerped; gyros turn with it.
+fn turn_uncorrected_proximal(
+    corrected: &mut Trial,
+    trial: &Trial,
+    model: &Model,
+    todo: &[(usize, JointLimits)],
+    k: usize,
+    hinges: &mut HashMap<usize, HingeFits>,
+    windows: &[Window],
+) {
+    let joint = &model.joints[k];
+    let Some(fits) = hinges.get_mut(&k) else {
+        return;
+    };
+    let above = todo
+        .iter()
+        .any(|(j, _)| model.joints[*j].distal == joint.proximal);
+    if above || joint.proximal == model.base || fits.axes.iter().all(|a| a.proximal.is_none()) {
+        return;
+    }
+    let np = Vector3::from(fits.hinge.segment_axes().0);
+    let qs: Vec<Quat> = (fits.axes.iter())
+        .map(|a| {
+            a.proximal
+                .map_or(Quat::identity(), |a| AxisFamily::new(&np, &a).swing())
+        })
+        .collect();
+    let centres: Vec<f64> = windows.iter().map(|w| w.centre_s).collect();
+    let series = correction_series(&trial.time_s, &centres, &qs);
+    let imu = corrected.imu_mut(&joint.proximal).expect("present");
+    for (q, c) in imu.orientation.iter_mut().zip(&series) {
+        *q = Quat::new_normalize((*q * c).into_inner());
+    }
+    if let Some(g) = &mut imu.gyro {
+        for (w, c) in g.iter_mut().zip(&series) {
+            *w = c.inverse() * *w;
+        }
+    }
+    fits.record.proximal_turned_by_axis = true;
+}
+
+/// Solves one joint whose distal IMU has a hinge axis in some windows: there
+/// the correction is searched over the turn about the axis only
+/// ([`hinge::minimise_about_axis`]); the other windows get the usual
+/// three-degree-of-freedom solution.
+fn solve_windows_with_axes(
+    (time_s, measured): (&[f64], &[Quat]),
+    windows: &[Window],
+    (limits, lambda1, solver): (&JointLimits, f64, Solver),
+    families: &[Option<AxisFamily>],
+    control: &RunControl,
+    progress: &(dyn Fn() + Sync),
+) -> Result<JointSolution, Cancelled> {
+    let free = if families.iter().any(Option::is_none) {
+        Some(solve_windows(
+            time_s,
+            measured,
+            windows,
+            (limits, lambda1, solver),
+            control,
+            progress,
+        )?)
+    } else {
+        None
+    };
+    let solutions: Vec<WindowSolution> = (windows.par_iter().zip(families).enumerate())
+        .map(|(k, (w, family))| {
+            let Some(family) = family else {
+                return Ok(free.as_ref().expect("solved").windows[k].clone());
+            };
+            if control.cancelled() {
+                return Err(Cancelled);
+            }
+            let cost = WindowCost::new(&measured[w.first..w.end], limits, lambda1);
+            // The size term counts the turn about the axis only (see `hinge`).
+            let about_axis =
+                |c: &Quat, phi: f64| cost.eval(c) - lambda1 * angle_deg(c) + lambda1 * phi.abs();
+            let s = hinge::minimise_about_axis(&about_axis, family);
+            if free.is_none() {
+                progress();
+            }
+            let c = canonical(&s.c);
+            Ok(WindowSolution {
+                start_s: w.start_s,
+                end_s: w.end_s,
+                centre_s: w.centre_s,
+                samples: w.len(),
+                correction: wxyz(&c),
+                angle_deg: angle_deg(&c),
+                cost: s.cost,
+                cost_uncorrected: cost.eval(&Quat::identity()),
+                evaluations: s.evaluations,
+            })
+        })
+        .collect::<Result<_, Cancelled>>()?;
+    let centres: Vec<f64> = solutions.iter().map(|w| w.centre_s).collect();
+    let qs: Vec<Quat> = (solutions.iter())
+        .map(|w| quat_from_wxyz(w.correction))
+        .collect();
+    Ok(JointSolution {
+        series: correction_series(time_s, &centres, &qs),
+        windows: solutions,
     })
 }
 

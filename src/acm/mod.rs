@@ -12,6 +12,7 @@ pub mod chain;
 pub mod cost;
 pub mod heading;
 pub mod heading_cost;
+pub mod hinge;
 pub mod lookahead;
 pub mod minimise;
 pub mod parent_cost;
@@ -59,6 +60,10 @@ pub enum Variant {
     /// IMU inverse kinematics (`crate::ik`): joint coordinates with the
     /// model's degrees of freedom and hard limits; not the ACM.
     Ik,
+    /// As `drift-centroid`, with the hinge axes of the model's hinge joints
+    /// estimated in both IMUs' frames ([`hinge`]): they fix two degrees of
+    /// freedom of the distal IMU's correction and of the proximal one's.
+    Hinge,
     /// No correction: the trial as read, after any pose or functional
     /// calibration (the step before every other variant).
     None,
@@ -66,7 +71,7 @@ pub enum Variant {
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 9] = [
+    pub const ALL: [Variant; 10] = [
         Variant::Basic,
         Variant::Drift,
         Variant::DriftCentroid,
@@ -75,6 +80,7 @@ impl Variant {
         Variant::Rivest,
         Variant::Mueller,
         Variant::Ik,
+        Variant::Hinge,
         Variant::None,
     ];
 
@@ -89,6 +95,7 @@ impl Variant {
             Variant::DriftHeading => "drift-heading",
             Variant::DriftHeadingCentroid => "drift-heading-centroid",
             Variant::Ik => "ik",
+            Variant::Hinge => "hinge",
             Variant::None => "none",
         }
     }
@@ -111,12 +118,18 @@ impl Variant {
                 | Variant::Rivest
                 | Variant::Mueller
                 | Variant::DriftHeadingCentroid
+                | Variant::Hinge
         )
     }
 
     /// Models drift as a heading rotation about the global vertical.
     pub fn heading(self) -> bool {
         matches!(self, Variant::DriftHeading | Variant::DriftHeadingCentroid)
+    }
+
+    /// Estimates the hinge joints' axes and corrects both of their IMUs with them.
+    pub fn hinge(self) -> bool {
+        self == Variant::Hinge
     }
 }
 
@@ -164,6 +177,15 @@ pub struct JointResult {
     /// corrects (`rivest`, `mueller`); absent for ACM joints.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub baseline: Option<crate::baselines::BaselineRecord>,
+    /// The hinge axes this joint's estimate found (`hinge` variant, hinge
+    /// joints only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hinge: Option<hinge::HingeRecord>,
+    /// The hinge joint below whose proximal-frame axis fixed two degrees of
+    /// freedom of this joint's correction (`hinge` variant), in the windows
+    /// where that axis was observed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis_from: Option<String>,
 }
 
 /// The heading correction of one window of a heading-drift variant.

@@ -1,0 +1,475 @@
+//! Hinge axes that inform both IMUs (the `hinge` variant, docs/method.md
+//! section 18).
+//!
+//! A hinge joint turns about axes fixed in its segments, so its measured
+//! rotations `Rm_i` (distal to proximal IMU frame) reveal those axes in both
+//! sensor frames: `a` in the proximal IMU's and `b` in the distal IMU's.
+//!
+//! - One-axis hinge (`hinge = "y"`, the knee): `Rm_i = M_p^-1 R_n(theta_i) M_d`,
+//!   so every relative rate, in the proximal frame, is parallel to
+//!   `a = M_p^-1 n`, and in the distal frame (`Rm_i^-1 w_i`) parallel to
+//!   `b = M_d^-1 n`. Each is the principal direction of the rates' scatter
+//!   `sum w w^T`; isotropic noise adds a multiple of the identity to it and
+//!   leaves the direction alone.
+//! - Two-axis hinge (`hinge = "z-x"`, the elbow): Z fixed in the proximal
+//!   segment, X in the distal one, found by the Mueller estimator
+//!   ([`crate::baselines::mueller::estimate_axes`]).
+//!
+//! An estimated axis fixes two of the three degrees of freedom of its IMU's
+//! correction: `C(phi) = S R_n(phi)`, with `S` the least rotation taking the
+//! segment axis `n` onto the estimated one and `phi` the turn about `n` that
+//! no axis can show. The limits decide `phi` by a one-dimensional search of
+//! the usual window cost ([`minimise_about_axis`]) whose size term counts
+//! `|phi|` instead of the angle of `C`: the swing is the axis' to decide, and
+//! beside a large swing the angle of `C` hardly changes with `phi`, so any
+//! noise at the limits would turn `phi` freely. An axis is used only where
+//! the joint turned about it by at least [`MIN_RANGE_DEG`] in the window (and,
+//! for a one-axis hinge, mostly about one axis); elsewhere the window falls
+//! back to the unconstrained correction and its record says why.
+//!
+//! Rates are rad/s, axes unit vectors in sensor frames, angles degrees in
+//! records.
+
+use super::window::Window;
+use crate::baselines::mueller::{
+    angle_between_axes_deg, estimate_axes, rates_from_gyros, rates_from_orientations, swing,
+    MuellerOptions,
+};
+use crate::baselines::{JointGyros, RateSource};
+use crate::model::Hinge;
+use crate::rotation::{wrap180, Quat};
+use nalgebra::{Matrix3, Unit, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Least turn about an axis within a window, degrees, for the axis to count
+/// as observed.
+pub const MIN_RANGE_DEG: f64 = 10.0;
+/// Largest ratio of the second to the first principal rate (RMS) of a
+/// one-axis hinge: beyond it the joint did not turn about one axis.
+pub const MAX_OFF_AXIS_RATIO: f64 = 0.5;
+/// Half the span (seconds) of the central difference that derives a one-axis
+/// hinge's rates from orientations: long enough that a slow knee turns by
+/// several degrees, so per-sample noise stays small beside it.
+pub const SINGLE_AXIS_HALF_SPAN_S: f64 = 0.25;
+/// Step of the scan over the turn about the axis, degrees.
+const SCAN_STEP_DEG: f64 = 2.0;
+/// Golden-section steps after the scan (the bracket shrinks to about 1e-8 deg).
+const REFINE_STEPS: usize = 60;
+
+/// The estimated axes of one window of one hinge joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HingeWindow {
+    /// Window centre, seconds from the first sample.
+    pub centre_s: f64,
+    /// The hinge axis in the proximal IMU's sensor frame (unit), when observed.
+    pub proximal_axis: Option<[f64; 3]>,
+    /// The hinge axis in the distal IMU's sensor frame (unit), when observed.
+    pub distal_axis: Option<[f64; 3]>,
+    /// Angle of each estimated axis from the IMU's own segment axis, degrees
+    /// (how far the sensor sat off the hinge).
+    pub proximal_tilt_deg: Option<f64>,
+    pub distal_tilt_deg: Option<f64>,
+    /// How far the joint turned about the proximal and the distal axis over the
+    /// window (max minus min), degrees.
+    pub proximal_range_deg: f64,
+    pub distal_range_deg: f64,
+    /// Why an axis was not used in this window (none: both were).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<String>,
+}
+
+/// What the `hinge` variant found for one hinge joint (kept in the sidecar).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HingeRecord {
+    /// The hinge as the model declares it (`y`, `z-x`, ...).
+    pub hinge: String,
+    /// Where the angular rates came from.
+    pub rates: RateSource,
+    /// Per window, in window order.
+    pub windows: Vec<HingeWindow>,
+    /// True when no joint above corrects the proximal IMU (its joint is
+    /// skipped or absent): the axis alone turned it, by the least rotation
+    /// taking the estimated axis onto the segment's.
+    #[serde(default)]
+    pub proximal_turned_by_axis: bool,
+}
+
+impl HingeRecord {
+    /// Windows where the proximal / the distal axis was used.
+    pub fn windows_used(&self) -> (usize, usize) {
+        let p = self.windows.iter().filter(|w| w.proximal_axis.is_some());
+        let d = self.windows.iter().filter(|w| w.distal_axis.is_some());
+        (p.count(), d.count())
+    }
+}
+
+/// The hinge axes of one window as vectors (sensor frames), when observed.
+#[derive(Debug, Clone, Copy)]
+pub struct WindowAxes {
+    pub proximal: Option<Vector3<f64>>,
+    pub distal: Option<Vector3<f64>>,
+}
+
+/// A joint's hinge estimate: the record and the axes per window.
+#[derive(Debug, Clone)]
+pub struct HingeFits {
+    pub hinge: Hinge,
+    pub record: HingeRecord,
+    pub axes: Vec<WindowAxes>,
+}
+
+/// Estimates a hinge joint's axes in every window from its measured rotations
+/// `Rm_i` (raw distal to raw proximal IMU frame), with rates from both IMUs'
+/// gyros when given (one reading per sample each), else from orientations.
+pub fn estimate_windows(
+    hinge: Hinge,
+    time_s: &[f64],
+    rm: &[Quat],
+    gyros: Option<JointGyros>,
+    windows: &[Window],
+) -> HingeFits {
+    let half_span = match hinge {
+        Hinge::Single(_) => SINGLE_AXIS_HALF_SPAN_S,
+        Hinge::ZX => MuellerOptions::default().rate_half_span_s,
+    };
+    let (rates, source) = match gyros {
+        Some(g) if g.proximal.len() == rm.len() && g.distal.len() == rm.len() => (
+            rates_from_gyros(rm, g.proximal, g.distal),
+            RateSource::Gyroscopes,
+        ),
+        _ => (
+            rates_from_orientations(time_s, rm, half_span),
+            RateSource::Orientations,
+        ),
+    };
+    let (fits, axes): (Vec<HingeWindow>, Vec<WindowAxes>) = windows
+        .iter()
+        .map(|w| {
+            let span = w.first..w.end;
+            estimate_window(hinge, w.centre_s, &rm[span.clone()], &rates[span])
+        })
+        .unzip();
+    HingeFits {
+        hinge,
+        record: HingeRecord {
+            hinge: hinge.name().to_string(),
+            rates: source,
+            windows: fits,
+            proximal_turned_by_axis: false,
+        },
+        axes,
+    }
+}
+
+/// The axes of one window from its joint rotations and relative rates
+/// (proximal frame).
+pub fn estimate_window(
+    hinge: Hinge,
+    centre_s: f64,
+    rm: &[Quat],
+    rates: &[Vector3<f64>],
+) -> (HingeWindow, WindowAxes) {
+    let (np, nd) = hinge.segment_axes();
+    let (np, nd) = (Vector3::from(np), Vector3::from(nd));
+    let estimate = match hinge {
+        Hinge::Single(_) => single_axis(rm, rates, &np, &nd),
+        Hinge::ZX => two_axes(rm, rates),
+    };
+    let Some((a, b, off_axis)) = estimate else {
+        let record = HingeWindow {
+            centre_s,
+            proximal_axis: None,
+            distal_axis: None,
+            proximal_tilt_deg: None,
+            distal_tilt_deg: None,
+            proximal_range_deg: 0.0,
+            distal_range_deg: 0.0,
+            fallback: Some("the joint hardly moved: no axis to estimate".into()),
+        };
+        let none = WindowAxes {
+            proximal: None,
+            distal: None,
+        };
+        return (record, none);
+    };
+    let (range_p, range_d) = turn_ranges(hinge, rm, &a, &b);
+    let mut reasons = Vec::new();
+    if let Some(r) = off_axis.filter(|r| *r > MAX_OFF_AXIS_RATIO) {
+        reasons.push(format!(
+            "the joint did not turn about one axis (second principal rate {r:.2} of the first, over {MAX_OFF_AXIS_RATIO})"
+        ));
+    }
+    let p_ok = reasons.is_empty() && range_p >= MIN_RANGE_DEG;
+    let d_ok = reasons.is_empty() && range_d >= MIN_RANGE_DEG;
+    if reasons.is_empty() && !(p_ok && d_ok) {
+        reasons.push(format!(
+            "the joint turned {range_p:.1} deg about the proximal axis and {range_d:.1} deg about the distal one (at least {MIN_RANGE_DEG} needed)"
+        ));
+    }
+    let axes = WindowAxes {
+        proximal: p_ok.then_some(a),
+        distal: d_ok.then_some(b),
+    };
+    let record = HingeWindow {
+        centre_s,
+        proximal_axis: axes.proximal.map(Into::into),
+        distal_axis: axes.distal.map(Into::into),
+        proximal_tilt_deg: axes.proximal.map(|a| angle_between_axes_deg(&a, &np)),
+        distal_tilt_deg: axes.distal.map(|b| angle_between_axes_deg(&b, &nd)),
+        proximal_range_deg: range_p,
+        distal_range_deg: range_d,
+        fallback: (!reasons.is_empty()).then(|| reasons.join("; ")),
+    };
+    (record, axes)
+}
+
+/// Principal direction of `vs` (sign towards `nominal`) and the RMS ratio of
+/// the second principal component to the first; none without movement.
+fn principal_axis(
+    vs: impl Iterator<Item = Vector3<f64>>,
+    nominal: &Vector3<f64>,
+) -> Option<(Vector3<f64>, f64)> {
+    let s = vs.fold(Matrix3::zeros(), |s, v| s + v * v.transpose());
+    let eig = s.symmetric_eigen();
+    let mut order = [0, 1, 2];
+    order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
+    let l1 = eig.eigenvalues[order[0]];
+    if !(l1.is_finite() && l1 > 0.0) {
+        return None;
+    }
+    let mut axis: Vector3<f64> = eig.eigenvectors.column(order[0]).normalize();
+    if axis.dot(nominal) < 0.0 {
+        axis = -axis;
+    }
+    let ratio = (eig.eigenvalues[order[1]].max(0.0) / l1).sqrt();
+    Some((axis, ratio))
+}
+
+/// One-axis hinge: the rates' principal direction in each frame.
+fn single_axis(
+    rm: &[Quat],
+    rates: &[Vector3<f64>],
+    np: &Vector3<f64>,
+    nd: &Vector3<f64>,
+) -> Option<(Vector3<f64>, Vector3<f64>, Option<f64>)> {
+    let (a, ratio) = principal_axis(rates.iter().copied(), np)?;
+    let distal = rm.iter().zip(rates).map(|(r, w)| r.inverse() * w);
+    let (b, _) = principal_axis(distal, nd)?;
+    Some((a, b, Some(ratio)))
+}
+
+/// Two-axis hinge: the Mueller estimate (Z in the proximal, X in the distal frame).
+fn two_axes(
+    rm: &[Quat],
+    rates: &[Vector3<f64>],
+) -> Option<(Vector3<f64>, Vector3<f64>, Option<f64>)> {
+    let opts = MuellerOptions {
+        max_samples: 1500,
+        ..MuellerOptions::default()
+    };
+    let fit = estimate_axes(rm, rates, &opts)?;
+    Some((fit.proximal_axis.into(), fit.distal_axis.into(), None))
+}
+
+/// Turn of `q` about the unit axis `u` (its twist), degrees in [-180, 180).
+fn twist_deg(q: &Quat, u: &Vector3<f64>) -> f64 {
+    wrap180(2f64.to_degrees() * q.imag().dot(u).atan2(q.w))
+}
+
+/// How far the joint turned about each axis over the window (max minus min),
+/// degrees. One-axis hinge: the twist about `a` of `Rm_i Rm_0^-1` (proximal
+/// frame) and about `b` of `Rm_0^-1 Rm_i` (distal frame). Two-axis hinge: the
+/// ranges of the Z and X angles once both axes are put onto the segments'.
+fn turn_ranges(hinge: Hinge, rm: &[Quat], a: &Vector3<f64>, b: &Vector3<f64>) -> (f64, f64) {
+    let range = |it: &mut dyn Iterator<Item = f64>| {
+        let (lo, hi) = it.fold((f64::MAX, f64::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        if hi >= lo {
+            hi - lo
+        } else {
+            0.0
+        }
+    };
+    let Some(first) = rm.first() else {
+        return (0.0, 0.0);
+    };
+    match hinge {
+        Hinge::Single(_) => (
+            range(&mut rm.iter().map(|r| twist_deg(&(r * first.inverse()), a))),
+            range(&mut rm.iter().map(|r| twist_deg(&(first.inverse() * r), b))),
+        ),
+        Hinge::ZX => {
+            let (np, nd) = hinge.segment_axes();
+            let cp = swing(a, &Vector3::from(np));
+            let cd_inv = swing(b, &Vector3::from(nd)).inverse();
+            let angles: Vec<[f64; 3]> = rm
+                .iter()
+                .map(|r| crate::rotation::euler_zyx_deg(&(cp * r * cd_inv)))
+                .collect();
+            (
+                range(&mut angles.iter().map(|e| e[2])),
+                range(&mut angles.iter().map(|e| e[0])),
+            )
+        }
+    }
+}
+
+/// The corrections of an IMU whose hinge axis is known:
+/// `C(phi) = S R_n(phi)`, where `S` takes the segment axis `n` onto the
+/// estimated sensor-frame axis, so the corrected frame's `n` is the hinge axis.
+#[derive(Debug, Clone, Copy)]
+pub struct AxisFamily {
+    swing: Quat,
+    axis: Unit<Vector3<f64>>,
+}
+
+impl AxisFamily {
+    /// The family for segment axis `segment` (unit) and estimated `sensor` axis.
+    pub fn new(segment: &Vector3<f64>, sensor: &Vector3<f64>) -> AxisFamily {
+        AxisFamily {
+            swing: swing(segment, sensor),
+            axis: Unit::new_normalize(*segment),
+        }
+    }
+
+    /// The least rotation of the family (`phi = 0`).
+    pub fn swing(&self) -> Quat {
+        self.swing
+    }
+
+    /// `C(phi)`, `phi` in degrees.
+    pub fn at(&self, phi_deg: f64) -> Quat {
+        self.swing * Quat::from_axis_angle(&self.axis, phi_deg.to_radians())
+    }
+}
+
+/// The best correction of a family and what it cost.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisSolution {
+    pub c: Quat,
+    /// The turn about the axis, degrees in [-180, 180).
+    pub phi_deg: f64,
+    pub cost: f64,
+    pub evaluations: usize,
+}
+
+/// Minimises `cost(C(phi), phi)` (`phi` in degrees) over the family: a scan
+/// of `phi` over the whole turn at 2 deg steps, then a golden-section search
+/// in the steps either side of the best (the first best on ties, so the
+/// result is deterministic).
+pub fn minimise_about_axis(cost: &dyn Fn(&Quat, f64) -> f64, family: &AxisFamily) -> AxisSolution {
+    let steps = (360.0 / SCAN_STEP_DEG).round() as usize;
+    let f = |phi: f64| cost(&family.at(phi), wrap180(phi));
+    let mut best = (0.0, f(0.0));
+    for k in 0..steps {
+        let phi = -180.0 + k as f64 * SCAN_STEP_DEG;
+        let v = f(phi);
+        if v < best.1 {
+            best = (phi, v);
+        }
+    }
+    let mut evaluations = steps + 1;
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut lo, mut hi) = (best.0 - SCAN_STEP_DEG, best.0 + SCAN_STEP_DEG);
+    let mut x1 = hi - g * (hi - lo);
+    let mut x2 = lo + g * (hi - lo);
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    evaluations += 2;
+    for _ in 0..REFINE_STEPS {
+        if f1 <= f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - g * (hi - lo);
+            f1 = f(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + g * (hi - lo);
+            f2 = f(x2);
+        }
+        evaluations += 1;
+    }
+    let (phi, v) = [(x1, f1), (x2, f2)]
+        .into_iter()
+        .fold(best, |b, c| if c.1 < b.1 { c } else { b });
+    let phi = wrap180(phi);
+    AxisSolution {
+        c: family.at(phi),
+        phi_deg: phi,
+        cost: v,
+        evaluations,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rotation::{quat_axis_angle_deg, quat_from_euler_zyx_deg};
+
+    /// A knee flexing 15-75 deg about Y with both sensors off the hinge.
+    fn knee(n: usize, dt: f64, mp: Quat, md: Quat) -> (Vec<f64>, Vec<Quat>) {
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+        let rm = t
+            .iter()
+            .map(|&s| {
+                let flex = 45.0 - 30.0 * (0.5 * s).cos();
+                mp.inverse() * quat_from_euler_zyx_deg([0.0, flex, 0.0]) * md
+            })
+            .collect();
+        (t, rm)
+    }
+
+    #[test]
+    fn one_axis_hinge_is_found_in_both_frames() {
+        let mp = quat_axis_angle_deg([1.0, 0.0, 0.3], 20.0);
+        let md = quat_axis_angle_deg([0.0, 0.2, 1.0], 25.0);
+        let (t, rm) = knee(3000, 0.02, mp, md);
+        let w = crate::acm::window::whole_trial(&t);
+        let fits = estimate_windows(Hinge::Single(crate::model::Axis::Y), &t, &rm, None, &w);
+        let ax = fits.axes[0];
+        let want_a = mp.inverse() * Vector3::y();
+        let want_b = md.inverse() * Vector3::y();
+        assert!(angle_between_axes_deg(&ax.proximal.unwrap(), &want_a) < 1e-6);
+        assert!(angle_between_axes_deg(&ax.distal.unwrap(), &want_b) < 1e-6);
+        let rec = &fits.record.windows[0];
+        assert!(rec.fallback.is_none());
+        assert!((rec.proximal_range_deg - 60.0).abs() < 0.1, "{rec:?}");
+        // The family's least rotation undoes the tilt: C y = a.
+        let fam = AxisFamily::new(&Vector3::y(), &ax.proximal.unwrap());
+        assert!((fam.at(17.0) * Vector3::y() - want_a).norm() < 1e-9);
+    }
+
+    #[test]
+    fn a_joint_that_barely_moves_falls_back() {
+        let n = 3000;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.02).collect();
+        let rm: Vec<Quat> = t
+            .iter()
+            .map(|&s| quat_from_euler_zyx_deg([0.0, 30.0 + 2.0 * s.sin(), 0.0]))
+            .collect();
+        let w = crate::acm::window::whole_trial(&t);
+        let fits = estimate_windows(Hinge::Single(crate::model::Axis::Y), &t, &rm, None, &w);
+        assert!(fits.axes[0].proximal.is_none() && fits.axes[0].distal.is_none());
+        let why = fits.record.windows[0].fallback.as_deref().unwrap();
+        assert!(why.contains("4.0 deg about the proximal axis"), "{why}");
+        // Not moving at all: no estimate.
+        let still = vec![Quat::identity(); n];
+        let fits = estimate_windows(Hinge::Single(crate::model::Axis::Y), &t, &still, None, &w);
+        assert!(fits.record.windows[0]
+            .fallback
+            .as_deref()
+            .unwrap()
+            .contains("hardly moved"));
+    }
+
+    #[test]
+    fn the_scan_finds_the_turn_a_cost_asks_for() {
+        let fam = AxisFamily::new(&Vector3::y(), &Vector3::new(0.1, 1.0, 0.0).normalize());
+        let target = fam.at(-123.4);
+        let cost = |c: &Quat, _: f64| crate::rotation::angle_between_deg(c, &target);
+        let s = minimise_about_axis(&cost, &fam);
+        assert!((s.phi_deg + 123.4).abs() < 1e-6, "{s:?}");
+        assert!(s.cost < 1e-6);
+    }
+}
