@@ -179,6 +179,7 @@ fn is_all_axes(v: &[Axis]) -> bool {
 
 /// One joint: the rotation of the distal IMU relative to the proximal one.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct Joint {
     /// Joint name, e.g. `l_knee`.
     pub name: String,
@@ -255,6 +256,7 @@ impl Joint {
 
 /// A body model: which IMUs exist, how they form joints, in which order to correct.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct Model {
     /// Short name, e.g. `infant13`.
     pub name: String,
@@ -295,10 +297,24 @@ pub enum ModelError {
         path: String,
         source: std::io::Error,
     },
-    #[error("{path}: {message}")]
-    Parse { path: String, message: String },
-    #[error("{path}: {message}")]
-    Invalid { path: String, message: String },
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse {
+        path: String,
+        /// 1-based line, 0 when the file as a whole is meant.
+        line: u64,
+        /// 1-based column (characters), 0 when the whole line is meant.
+        column: usize,
+        message: String,
+    },
+    #[error("{path}:{line}:{column}: {message}")]
+    Invalid {
+        path: String,
+        /// 1-based line of what the message names, 0 when it names nothing.
+        line: u64,
+        /// 1-based column, 0 when the whole line is meant.
+        column: usize,
+        message: String,
+    },
     #[error(
         "unknown built-in model '{0}' (known: infant13, opensim, opensense_lower, full_body16)"
     )]
@@ -327,7 +343,7 @@ impl Model {
             return Model::builtin(name_or_path);
         }
         let path = Path::new(name_or_path);
-        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+        let text = crate::input::read_text(path).map_err(|source| ModelError::Io {
             path: name_or_path.to_string(),
             source,
         })?;
@@ -336,15 +352,39 @@ impl Model {
 
     /// Parses and validates a model from TOML text; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Model, ModelError> {
-        let model: Model = toml::from_str(text).map_err(|e| ModelError::Parse {
-            path: origin.to_string(),
-            message: e.to_string(),
+        let model: Model = toml::from_str(text).map_err(|e| {
+            let (line, column) = e
+                .span()
+                .map(|sp| crate::calibration::error::line_col(text, sp.start))
+                .unwrap_or((0, 0));
+            ModelError::Parse {
+                path: origin.to_string(),
+                line,
+                column,
+                message: e.message().trim().to_string(),
+            }
         })?;
-        model.validate().map_err(|message| ModelError::Invalid {
-            path: origin.to_string(),
-            message,
+        model.validate().map_err(|message| {
+            let line = crate::input::line_naming(text, &message).unwrap_or(0);
+            ModelError::Invalid {
+                path: origin.to_string(),
+                line,
+                column: usize::from(line > 0),
+                message,
+            }
         })?;
         Ok(model)
+    }
+
+    /// Checks a model that did not come from a file (a sidecar's) as
+    /// [`Model::from_toml`] checks one that did; `origin` names it in errors.
+    pub fn check(&self, origin: &str) -> Result<(), ModelError> {
+        self.validate().map_err(|message| ModelError::Invalid {
+            path: origin.to_string(),
+            line: 0,
+            column: 0,
+            message,
+        })
     }
 
     fn validate(&self) -> Result<(), String> {

@@ -146,6 +146,26 @@ impl Sidecar {
         Ok(t)
     }
 
+    /// Checks what the sidecar would run with as if it came from files:
+    /// settings ([`Settings::validate`]), model ([`Model::check`]) and the
+    /// limit table (its hash, and rows for every joint kind of the model).
+    pub fn check(&self, origin: &str) -> anyhow::Result<()> {
+        self.settings
+            .validate(&format!("{origin} (settings)"))?;
+        self.model.check(&format!("{origin} (model)"))?;
+        let table = self.table(origin)?;
+        table.check_covers(&self.model, &format!("{origin} (limits.csv)"))?;
+        Ok(())
+    }
+
+    /// `None` when `input` hashes to the recorded input SHA-256, else the hash found.
+    pub fn check_input(&self, input: &Path) -> anyhow::Result<Option<String>> {
+        let bytes = crate::trial::input_bytes(input)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", input.display()))?;
+        let found = sha256_hex(&bytes);
+        Ok((found != self.input.sha256).then_some(found))
+    }
+
     /// Pretty JSON text.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("sidecar serialises")
@@ -153,7 +173,7 @@ impl Sidecar {
 
     /// Reads a sidecar file.
     pub fn load(path: &Path) -> anyhow::Result<Sidecar> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::input::read_text(path)
             .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
         serde_json::from_str(&text).map_err(|e| {
             anyhow::anyhow!(

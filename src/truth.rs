@@ -193,7 +193,7 @@ fn load(csv: &Path, json: &Path, model: &Model) -> Result<Truth, TrialError> {
             "missing: a truth needs its .truth.json file (the .truth.csv.gz is optional)",
         ));
     }
-    let text = std::fs::read_to_string(json)
+    let text = crate::input::read_text(json)
         .map_err(|e| TrialError::file(&json_name, format!("cannot read: {e}")))?;
     let meta = TruthMeta::from_json(&text, &json_name)?;
     if meta.model != model.name {

@@ -118,7 +118,7 @@ pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
     if is_xsens_path(path) {
         super::xsens_trial::input_bytes(path)
     } else {
-        std::fs::read(path)
+        crate::input::read_bytes(path)
     }
 }
 
@@ -191,13 +191,15 @@ fn to_text(bytes: Vec<u8>, origin: &str, kind: Kind, gzip: bool) -> Result<Strin
 /// Reads and decompresses the whole file.
 fn read_text(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> {
     let origin = origin_of(path);
-    let raw = std::fs::read(path).map_err(|e| cannot_read(&origin, e))?;
+    let raw = crate::input::read_bytes(path).map_err(|e| cannot_read(&origin, e))?;
     let bytes = if gzip {
-        let mut out = Vec::with_capacity(raw.len().saturating_mul(4));
-        flate2::read::MultiGzDecoder::new(&raw[..])
-            .read_to_end(&mut out)
-            .map_err(|e| bad_gzip(&origin, e))?;
-        out
+        crate::input::gunzip_capped(&raw).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::InvalidData && e.to_string().contains("more than") {
+                TrialError::file(&origin, format!("cannot read: {e}"))
+            } else {
+                bad_gzip(&origin, e)
+            }
+        })?
     } else {
         raw
     };
@@ -208,7 +210,7 @@ fn read_text(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> 
 /// the first non-blank line after `endheader`.
 fn read_head(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> {
     let origin = origin_of(path);
-    let file = std::fs::File::open(path).map_err(|e| cannot_read(&origin, e))?;
+    let file = crate::input::open_regular(path).map_err(|e| cannot_read(&origin, e))?;
     let mut reader: Box<dyn BufRead> = if gzip {
         Box::new(BufReader::new(flate2::read::MultiGzDecoder::new(
             BufReader::new(file),

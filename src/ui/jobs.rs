@@ -67,7 +67,7 @@ pub fn limits_state(dir: &Path, d: LimitsDir) -> LimitsState {
 
 /// Reads the limit files in `dir` as they are on disk now (None if absent or bad).
 pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<(LimitTable, SettingsFile)> {
-    let s = std::fs::read_to_string(dir.join("settings.toml")).ok()?;
+    let s = crate::input::read_text(&dir.join("settings.toml")).ok()?;
     let settings = SettingsFile::parse(&s, "settings.toml").ok()?;
     let name = if settings.table.is_empty() {
         table_name
@@ -132,6 +132,8 @@ pub fn run_job(job: &RunJob, cancel: &AtomicBool, progress: &(dyn Fn(u8) + Sync)
     let l = &job.loaded;
     let n = Variant::ALL.len();
     let result = (|| {
+        let s = &job.settings;
+        crate::acm::window::check_layout(&l.trial.time_s, s.window_s, s.hop_s)?;
         let mut out: Vec<Arc<Correction>> = Vec::with_capacity(n);
         for (k, v) in Variant::ALL.into_iter().enumerate() {
             let report = move |done: usize, total: usize| {
