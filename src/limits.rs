@@ -212,6 +212,9 @@ impl LimitsDir {
     pub fn load(dir: &Path) -> Result<LimitsDir, LimitsError> {
         let settings_path = dir.join("settings.toml");
         let origin = settings_path.display().to_string();
+        // Finish a save of table and settings that a kill interrupted (a
+        // read-only folder has none to finish).
+        let _ = crate::save::recover(dir);
         let (settings, text) = if settings_path.exists() {
             let text = crate::input::read_text(&settings_path).map_err(|e| LimitsError {
                 file: origin.clone(),

@@ -601,7 +601,12 @@ distal = "b"
         let e = Model::from_toml("name = 3", "m.toml")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("m.toml") && e.contains("line 1"), "{e}");
+        assert!(e.starts_with("m.toml:1:8: invalid type"), "{e}");
+        // A misspelt key is an error at its line, not silently ignored.
+        let e = Model::from_toml("name = \"m\"\nbasee = \"a\"\n", "m.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("m.toml:2:1: unknown field `basee`"), "{e}");
     }
 
     #[test]
@@ -650,7 +655,8 @@ distal = "b"
         let base = "name = \"x\"\nbase = \"a\"\nimus = [\"a\", \"b\"]\n[[joint]]\nname = \"j\"\nkind = \"knee\"\nproximal = \"a\"\ndistal = \"b\"\n";
         let cases = [
             ("dof = [\"y\", \"y\"]", "listed twice"),
-            ("dof = [\"w\"]", "line"),
+            ("dof = [\"w\"]", "m.toml:9:8: unknown variant"),
+            ("doff = [\"y\"]", "m.toml:9:1: unknown field `doff`"),
             (
                 "dof = [\"y\"]\nhard_limits_deg = { x = [0, 10] }",
                 "not in `dof`",

@@ -9,7 +9,7 @@ use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
 use crate::pose::PoseRecord;
-use crate::save::atomic_write;
+use crate::save::{atomic_write, OutputLock};
 use crate::trial::{write_trial, Trial, TrialFormat};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -51,6 +51,11 @@ pub struct Sidecar {
     pub version: String,
     pub input: InputRecord,
     pub output: String,
+    /// SHA-256 of the output file's bytes as written: a reader of the output
+    /// can tell whether this sidecar describes it (a save cut short between
+    /// the trial and its sidecar leaves them apart).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_sha256: Option<String>,
     pub output_format: TrialFormat,
     pub variant: Variant,
     pub settings: Settings,
@@ -115,6 +120,7 @@ impl Sidecar {
             version: env!("CARGO_PKG_VERSION").into(),
             input,
             output: output.display().to_string(),
+            output_sha256: None,
             output_format,
             variant: correction.variant,
             settings: correction.settings,
@@ -184,6 +190,27 @@ impl Sidecar {
             )
         })
     }
+}
+
+/// A warning when the sidecar beside the trial file `path` does not describe
+/// these bytes of it (the file was replaced after the sidecar was written, or
+/// a save was cut short between them); `None` when it does, or there is no
+/// sidecar or it records no output hash.
+pub fn mismatch_warning(path: &Path, bytes: &[u8]) -> Option<String> {
+    let sc_path = sidecar_path(path);
+    if !sc_path.is_file() {
+        return None;
+    }
+    let recorded = match Sidecar::load(&sc_path) {
+        Ok(s) => s.output_sha256?,
+        Err(e) => return Some(format!("sidecar beside it is unreadable: {e}")),
+    };
+    (sha256_hex(bytes) != recorded).then(|| {
+        format!(
+            "{} does not describe this file (output SHA-256 differs): the file changed after that correction was saved",
+            sc_path.display()
+        )
+    })
 }
 
 /// The default output path of a corrected trial:
@@ -280,12 +307,19 @@ impl SaveRequest<'_> {
 
     /// Writes the corrected trial and the given sidecar (built by
     /// [`SaveRequest::sidecar`], perhaps amended), as [`SaveRequest::save`] does.
-    pub fn save_with(&self, sidecar: Sidecar) -> anyhow::Result<PathBuf> {
+    /// The output and its sidecar are written under an [`OutputLock`]: a
+    /// second run writing the same output waits, then refuses.
+    pub fn save_with(&self, mut sidecar: Sidecar) -> anyhow::Result<PathBuf> {
         if let Some(dir) = self.output.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| anyhow::anyhow!("{}: cannot create folder: {e}", dir.display()))?;
         }
+        let _lock = OutputLock::acquire(self.output)
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", self.output.display()))?;
         write_trial(&self.correction.corrected, self.output, self.output_format)?;
+        let written = std::fs::read(self.output)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read back: {e}", self.output.display()))?;
+        sidecar.output_sha256 = Some(sha256_hex(&written));
         if let Some(run) = &self.correction.ik {
             write_coordinates(run, &coordinates_path(self.output))?;
         }

@@ -333,9 +333,9 @@ impl Calibration {
     }
 
     /// Writes the calibration file atomically (the previous one kept as `.bak`).
-    pub fn save(&self, path: &Path) -> Result<(), CalibrationError> {
+    pub fn save(&self, path: &Path) -> Result<(), crate::save::WriteError> {
         crate::save::atomic_write(path, self.to_toml().as_bytes()).map_err(|e| {
-            CalibrationError::file(path.display().to_string(), format!("cannot write: {e}"))
+            crate::save::WriteError::io(path, &e)
         })
     }
 

@@ -233,11 +233,13 @@ pub fn save_limits(dir: &Path, table_name: &str, table_csv: &str, settings_toml:
     let result = (|| {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         let table: PathBuf = dir.join(table_name);
-        crate::save::atomic_write(&table, table_csv.as_bytes())
-            .map_err(|e| format!("{}: {e}", table.display()))?;
         let settings = dir.join("settings.toml");
-        crate::save::atomic_write(&settings, settings_toml.as_bytes())
-            .map_err(|e| format!("{}: {e}", settings.display()))?;
+        // One commit: the table and the settings naming it change together.
+        crate::save::atomic_write_all(&[
+            (&table, table_csv.as_bytes()),
+            (&settings, settings_toml.as_bytes()),
+        ])
+        .map_err(|e| format!("{}: cannot write: {e}", table.display()))?;
         Ok(table.display().to_string())
     })();
     Msg::LimitsSaved(result)
