@@ -113,14 +113,43 @@ pub fn read_bytes(path: &Path) -> io::Result<Vec<u8>> {
 
 /// The text of the regular file at `path` (UTF-8), at most [`max_input_bytes`].
 pub fn read_text(path: &Path) -> io::Result<String> {
-    String::from_utf8(read_bytes(path)?).map_err(|e| {
-        io::Error::new(
-            io::ErrorKind::InvalidData,
-            format!(
-                "expected UTF-8 text, found an invalid byte at offset {}",
-                e.utf8_error().valid_up_to()
+    read_text_located(path).map_err(|e| e.error)
+}
+
+/// Why a file could not be read as text, and where: line and column (1-based,
+/// characters) of an invalid UTF-8 byte, 0 and 0 when the file as a whole is meant.
+#[derive(Debug)]
+pub struct ReadFailure {
+    pub line: u64,
+    pub column: usize,
+    pub error: io::Error,
+}
+
+/// [`read_text`], locating invalid UTF-8 by line and column.
+pub fn read_text_located(path: &Path) -> Result<String, ReadFailure> {
+    let whole = |error| ReadFailure {
+        line: 0,
+        column: 0,
+        error,
+    };
+    let bytes = read_bytes(path).map_err(whole)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let before = String::from_utf8_lossy(&bytes[..at]);
+        let line = before.matches('\n').count() as u64 + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        ReadFailure {
+            line,
+            column,
+            error: io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "expected UTF-8 text, found invalid byte 0x{:02x}",
+                    bytes[at]
+                ),
             ),
-        )
+        }
     })
 }
 
@@ -156,7 +185,10 @@ mod tests {
         assert!(e.to_string().contains("found a folder"), "{e}");
         let e = read_to_end_capped(&[0u8; 11][..], 10, "data is").unwrap_err();
         assert!(e.to_string().starts_with("data is more than"), "{e}");
-        assert_eq!(read_to_end_capped(&[0u8; 10][..], 10, "x").unwrap().len(), 10);
+        assert_eq!(
+            read_to_end_capped(&[0u8; 10][..], 10, "x").unwrap().len(),
+            10
+        );
     }
 
     #[cfg(unix)]

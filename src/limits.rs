@@ -216,12 +216,13 @@ impl LimitsDir {
         // read-only folder has none to finish).
         let _ = crate::save::recover(dir);
         let (settings, text) = if settings_path.exists() {
-            let text = crate::input::read_text(&settings_path).map_err(|e| LimitsError {
-                file: origin.clone(),
-                line: 0,
-                column: 0,
-                message: format!("cannot read: {e}"),
-            })?;
+            let text =
+                crate::input::read_text_located(&settings_path).map_err(|e| LimitsError {
+                    file: origin.clone(),
+                    line: e.line,
+                    column: e.column,
+                    message: format!("cannot read: {}", e.error),
+                })?;
             (SettingsFile::parse(&text, &origin)?, Some(text))
         } else {
             let builtin = SettingsFile::parse(BUILTIN_SETTINGS, "<built-in settings.toml>")?;
@@ -332,11 +333,11 @@ impl LimitTable {
     /// Reads and parses a limit table file.
     pub fn load(path: &Path) -> Result<LimitTable, LimitsError> {
         let origin = path.display().to_string();
-        let text = crate::input::read_text(path).map_err(|e| LimitsError {
+        let text = crate::input::read_text_located(path).map_err(|e| LimitsError {
             file: origin.clone(),
-            line: 0,
-            column: 0,
-            message: format!("cannot read: {e}"),
+            line: e.line,
+            column: e.column,
+            message: format!("cannot read: {}", e.error),
         })?;
         LimitTable::parse(&text, &origin)
     }

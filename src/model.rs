@@ -343,9 +343,20 @@ impl Model {
             return Model::builtin(name_or_path);
         }
         let path = Path::new(name_or_path);
-        let text = crate::input::read_text(path).map_err(|source| ModelError::Io {
-            path: name_or_path.to_string(),
-            source,
+        let text = crate::input::read_text_located(path).map_err(|e| {
+            if e.line > 0 {
+                ModelError::Parse {
+                    path: name_or_path.to_string(),
+                    line: e.line,
+                    column: e.column,
+                    message: e.error.to_string(),
+                }
+            } else {
+                ModelError::Io {
+                    path: name_or_path.to_string(),
+                    source: e.error,
+                }
+            }
         })?;
         Model::from_toml(&text, name_or_path)
     }

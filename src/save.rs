@@ -95,8 +95,15 @@ pub fn atomic_write_all(files: &[(&Path, &[u8])]) -> io::Result<()> {
         .iter()
         .map(|(t, p)| {
             [
-                t.path().file_name().unwrap_or_default().to_string_lossy().into_owned(),
-                p.file_name().unwrap_or_default().to_string_lossy().into_owned(),
+                t.path()
+                    .file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned(),
+                p.file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .into_owned(),
             ]
         })
         .collect();
@@ -188,11 +195,16 @@ fn keep_backup(path: &Path, dir: &Path) -> io::Result<()> {
         .suffix(".tmp")
         .make_in(dir, |p| fs::hard_link(path, p));
     match name {
-        Ok(link) => link.persist(backup_path(path)).map(|_| ()).map_err(|e| e.error),
+        Ok(link) => link
+            .persist(backup_path(path))
+            .map(|_| ())
+            .map_err(|e| e.error),
         Err(_) => {
             let bytes = fs::read(path)?;
             let copy = write_temp(dir, &bytes, path)?;
-            copy.persist(backup_path(path)).map(|_| ()).map_err(|e| e.error)
+            copy.persist(backup_path(path))
+                .map(|_| ())
+                .map_err(|e| e.error)
         }
     }
 }

@@ -156,8 +156,7 @@ impl Sidecar {
     /// settings ([`Settings::validate`]), model ([`Model::check`]) and the
     /// limit table (its hash, and rows for every joint kind of the model).
     pub fn check(&self, origin: &str) -> anyhow::Result<()> {
-        self.settings
-            .validate(&format!("{origin} (settings)"))?;
+        self.settings.validate(&format!("{origin} (settings)"))?;
         self.model.check(&format!("{origin} (model)"))?;
         let table = self.table(origin)?;
         table.check_covers(&self.model, &format!("{origin} (limits.csv)"))?;

@@ -379,7 +379,9 @@ mod tests {
         // Settings that would need billions of windows are refused by the check
         // and bounded by the layout itself.
         let t = times(100.0, 100.0);
-        assert!(check_layout(&t, 1e-6, 1e-6).unwrap_err().contains("fewer than 4 samples"));
+        assert!(check_layout(&t, 1e-6, 1e-6)
+            .unwrap_err()
+            .contains("fewer than 4 samples"));
         assert!(check_layout(&t, 1.0, 1e-6).unwrap_err().contains("windows"));
         assert!(check_layout(&t, 60.0, 30.0).is_ok());
         assert!(layout(&t, 1.0, 1e-6).len() <= MAX_WINDOWS);
@@ -408,7 +410,10 @@ mod tests {
                 }
             }
             let [x, y] = win.borrowed_s.unwrap();
-            assert!((x - a).abs() < 1e-6 && (y - b).abs() < 1e-6, "{win:?} vs {a} {b}");
+            assert!(
+                (x - a).abs() < 1e-6 && (y - b).abs() < 1e-6,
+                "{win:?} vs {a} {b}"
+            );
         }
     }
 

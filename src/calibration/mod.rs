@@ -327,16 +327,21 @@ impl Calibration {
     /// Reads a calibration file.
     pub fn load(path: &Path) -> Result<Calibration, CalibrationError> {
         let origin = path.display().to_string();
-        let text = crate::input::read_text(path)
-            .map_err(|e| CalibrationError::file(&origin, format!("cannot read: {e}")))?;
+        let text = crate::input::read_text_located(path).map_err(|e| {
+            CalibrationError::at(
+                &origin,
+                e.line,
+                e.column,
+                format!("cannot read: {}", e.error),
+            )
+        })?;
         Calibration::from_toml(&text, &origin)
     }
 
     /// Writes the calibration file atomically (the previous one kept as `.bak`).
     pub fn save(&self, path: &Path) -> Result<(), crate::save::WriteError> {
-        crate::save::atomic_write(path, self.to_toml().as_bytes()).map_err(|e| {
-            crate::save::WriteError::io(path, &e)
-        })
+        crate::save::atomic_write(path, self.to_toml().as_bytes())
+            .map_err(|e| crate::save::WriteError::io(path, &e))
     }
 
     /// What applying it to a trial does: per IMU the rotation. `text` is the

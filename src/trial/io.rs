@@ -364,10 +364,10 @@ pub fn write_trial(
             .is_some_and(|g| g.len() != trial.time_s.len())
     }) {
         return Err(refused(format!(
-                "cannot write: IMU '{}' has {} gyroscope readings, expected one per time ({})",
-                bad.name,
-                bad.gyro.as_ref().map_or(0, Vec::len),
-                trial.time_s.len()
+            "cannot write: IMU '{}' has {} gyroscope readings, expected one per time ({})",
+            bad.name,
+            bad.gyro.as_ref().map_or(0, Vec::len),
+            trial.time_s.len()
         )));
     }
     if let Some(bad) = trial
@@ -376,10 +376,10 @@ pub fn write_trial(
         .find(|s| s.orientation.len() != trial.time_s.len())
     {
         return Err(refused(format!(
-                "cannot write: IMU '{}' has {} samples, expected one per time ({})",
-                bad.name,
-                bad.orientation.len(),
-                trial.time_s.len()
+            "cannot write: IMU '{}' has {} samples, expected one per time ({})",
+            bad.name,
+            bad.orientation.len(),
+            trial.time_s.len()
         )));
     }
     let (kind, gzip) = match kind_of_name(path) {
