@@ -67,9 +67,35 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let dir = folder_of(path);
     remove_stale_temps(&dir);
     let tmp = write_temp(&dir, bytes, path)?;
-    commit(tmp, path)?;
+    step();
+    keep_backup(path, &dir)?;
+    step();
+    tmp.persist(path).map_err(|e| e.error)?;
+    step();
     sync_dir(&dir);
     Ok(())
+}
+
+/// Environment variable naming a save step (1, 2, ...) at which the process
+/// kills itself with SIGKILL: how the tests kill a save at each of its steps.
+pub const KILL_AT_STEP_ENV: &str = "ACMW_KILL_AT_SAVE_STEP";
+
+/// Counts a step of a save (a temporary written, a backup made, a rename)
+/// and dies at the one [`KILL_AT_STEP_ENV`] names, if any.
+fn step() {
+    use std::sync::atomic::{AtomicU32, Ordering};
+    static STEPS: AtomicU32 = AtomicU32::new(0);
+    static AT: std::sync::OnceLock<Option<u32>> = std::sync::OnceLock::new();
+    let at = *AT.get_or_init(|| std::env::var(KILL_AT_STEP_ENV).ok()?.parse().ok());
+    let n = STEPS.fetch_add(1, Ordering::SeqCst) + 1;
+    if at == Some(n) {
+        #[cfg(unix)]
+        // SAFETY: sends SIGKILL to this process; nothing after it runs.
+        unsafe {
+            libc::kill(libc::getpid(), libc::SIGKILL);
+        }
+        std::process::abort();
+    }
 }
 
 /// Writes several files so that either all are replaced or none (see the
@@ -114,11 +140,14 @@ pub fn atomic_write_all(files: &[(&Path, &[u8])]) -> io::Result<()> {
         .into_iter()
         .map(|(t, p)| t.keep().map(|(_, tp)| (tp, p)).map_err(|e| e.error))
         .collect::<io::Result<_>>()?;
+    step();
     let journal_tmp = write_temp(&dir, &text, &journal)?;
     journal_tmp.persist(&journal).map_err(|e| e.error)?;
+    step();
     sync_dir(&dir);
     for (tmp, path) in &kept {
         backup_then_rename(tmp, path)?;
+        step();
     }
     sync_dir(&dir);
     fs::remove_file(&journal)?;
@@ -168,13 +197,6 @@ fn write_temp(dir: &Path, bytes: &[u8], target: &Path) -> io::Result<tempfile::N
     tmp.as_file().set_permissions(perms)?;
     tmp.as_file().sync_all()?;
     Ok(tmp)
-}
-
-/// Keeps the old `path` as its backup, then renames the temporary into place.
-fn commit(tmp: tempfile::NamedTempFile, path: &Path) -> io::Result<()> {
-    keep_backup(path, &folder_of(path))?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
 }
 
 fn backup_then_rename(tmp: &Path, path: &Path) -> io::Result<()> {
