@@ -25,6 +25,7 @@ pub mod pose;
 pub mod render;
 pub mod runtime;
 pub mod scatter;
+pub mod signals;
 pub mod stick;
 pub mod theme;
 pub mod trial;
