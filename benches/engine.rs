@@ -1,4 +1,4 @@
-//! Engine benchmarks (issue 3): loading, whole-trial correction of 5- and
+//! Engine benchmarks: loading, whole-trial correction of 5- and
 //! 30-minute 13-IMU trials at 50 Hz, one joint re-corrected, the heading-drift
 //! variants against the source's (`-- heading`), and peak memory.
 //!
@@ -118,7 +118,7 @@ fn benches(c: &mut Criterion) {
     g.finish();
 
     // The heading model against the source's on the same 5-minute trials, one
-    // without drift and the drifting preset (issue 9: within 2x).
+    // without drift and the drifting preset (the target: within 2x).
     let drifting = simulate(&preset("full_body_drift").unwrap()).unwrap().trial;
     let mut g = c.benchmark_group("heading");
     g.sample_size(10).measurement_time(Duration::from_secs(20));

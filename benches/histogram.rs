@@ -1,4 +1,4 @@
-//! Histogram screen benchmarks (issue 7): a frame of the histogram screen of a
+//! Histogram screen benchmarks: a frame of the histogram screen of a
 //! 30-minute, 13-IMU trial at 200x60, over the first 30 s (the default) and
 //! over the whole trial, and the work of choosing a span (pooling the angles
 //! and binning them) for both.

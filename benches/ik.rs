@@ -1,9 +1,9 @@
-//! IMU inverse kinematics throughput (issue 6): 13 IMUs at 50 Hz, one core.
+//! IMU inverse kinematics throughput: 13 IMUs at 50 Hz, one core.
 //!
 //! Run with `cargo bench --bench ik`. Each case solves a 60-second trial
 //! (3,000 frames, frames in order, each warm-started from the last; the solver
-//! uses no threads). Real-time ratio = 60 s / measured time; the issue asks
-//! for at least 20. Cases:
+//! uses no threads). Real-time ratio = 60 s / measured time; the target
+//! is at least 20. Cases:
 //! - `exact`: orientations that the model's reduced degrees of freedom can
 //!   reproduce exactly (residuals vanish);
 //! - `noisy`: the same motion with 1 deg RMS noise per IMU;

@@ -44,7 +44,7 @@ fn benches(c: &mut Criterion) {
         b.iter(|| draw(&app, &theme, 200, 60))
     });
 
-    // The analysis views (issue 7) of the same trial, each drawn as the
+    // The analysis views of the same trial, each drawn as the
     // runtime draws it; the globe also on a shoulder (a wide limit band).
     for (view, joint) in [
         ("scatter", "l_knee"),

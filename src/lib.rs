@@ -15,6 +15,7 @@ pub mod metrics;
 pub mod model;
 pub mod plot;
 pub mod pose;
+pub mod reference;
 pub mod report;
 pub mod rotation;
 pub mod save;

@@ -1,4 +1,4 @@
-//! Joint limit tables (METHOD.md section 5) and correction settings.
+//! Joint limit tables (docs/method.md section 4) and correction settings.
 //!
 //! A limit table is a CSV file, one row per joint and axis:
 //!
@@ -68,7 +68,7 @@ pub struct JointLimits {
     pub range_deg: [[f64; 2]; 3],
     /// Centroid Z-Y-X angles, degrees, when the table sets one.
     pub centroid_deg: Option<[f64; 3]>,
-    /// Weight of the centroid term (METHOD.md section 3).
+    /// Weight of the centroid term (docs/method.md section 5).
     pub lambda2: f64,
 }
 
@@ -99,7 +99,7 @@ pub struct LimitsError {
 pub struct Settings {
     /// Weight of the correction's rotation angle in the cost (per degree).
     pub lambda1: f64,
-    /// Window length, seconds (METHOD.md section 4).
+    /// Window length, seconds (docs/method.md section 7).
     pub window_s: f64,
     /// Hop between window starts, seconds.
     pub hop_s: f64,
@@ -190,7 +190,7 @@ impl SettingsFile {
     /// TOML text for saving.
     pub fn to_toml(&self) -> String {
         format!(
-            "# Correction settings (METHOD.md sections 3-4); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n",
+            "# Correction settings (docs/method.md sections 4-7); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n",
             self.table, self.lambda1, self.window_s, self.hop_s, self.vertical.name(), self.glitch_deg
         )
     }

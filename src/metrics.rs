@@ -1,4 +1,4 @@
-//! The figures a researcher reports (METHOD.md section 6, thesis 4.4-4.6).
+//! The figures a researcher reports (docs/method.md section 16, thesis 4.4-4.6).
 //!
 //! All angles are degrees; joint angles are the Z-Y-X Euler angles of
 //! `(G_R_prox)^T * G_R_dist` taken from whichever trial is given (raw or corrected).
@@ -35,6 +35,12 @@ pub struct ExcursionFigures {
     pub pct_outside_any: f64,
 }
 
+/// An angle beyond a limit by at most this counts as inside, degrees: writing
+/// and reading a trial moves angles by ~1e-13 deg, which must not move a
+/// sample that sits on a limit (inverse kinematics clamps coordinates to their
+/// hard limits, which may be a table's limits) across it.
+pub const ON_LIMIT_DEG: f64 = 1e-9;
+
 /// Excursion figures of joint angles against limits.
 pub fn excursion_figures(angles: &[[f64; 3]], limits: &JointLimits) -> ExcursionFigures {
     let n = angles.len().max(1) as f64;
@@ -45,9 +51,9 @@ pub fn excursion_figures(angles: &[[f64; 3]], limits: &JointLimits) -> Excursion
         let e = excursion(*a, &limits.range_deg);
         for k in 0..3 {
             sum[k] += e[k];
-            out_count[k] += usize::from(e[k] > 0.0);
+            out_count[k] += usize::from(e[k] > ON_LIMIT_DEG);
         }
-        any += usize::from(e.iter().any(|&x| x > 0.0));
+        any += usize::from(e.iter().any(|&x| x > ON_LIMIT_DEG));
     }
     ExcursionFigures {
         pct_outside: out_count.map(|c| 100.0 * c as f64 / n),

@@ -1,8 +1,8 @@
-//! Body models as data (METHOD.md section 2): IMUs, joints, correction order, aliases.
+//! Body models as data (docs/method.md section 3): IMUs, joints, correction order, aliases.
 //!
-//! A model is a TOML file. Two ship inside the binary (`infant13`, the source
-//! study's 13-IMU suit, and `opensim`, the OpenSim full-body IMU set); a lab can
-//! point `--model` at its own file. See `models/README.md` for the format.
+//! A model is a TOML file. Four ship inside the binary (`infant13`, the source
+//! study's 13-IMU suit, `opensim`, `opensense_lower` and `full_body16`); a lab can
+//! point `--model` at its own file. The README's "Body models" gives the format.
 
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashSet};
@@ -19,7 +19,7 @@ pub const BUILTIN_MODELS: &[(&str, &str)] = &[
     ("full_body16", include_str!("../models/full_body16.toml")),
 ];
 
-/// An axis of a joint's Z-Y-X Euler angles (METHOD.md section 1).
+/// An axis of a joint's Z-Y-X Euler angles (docs/method.md section 2.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub enum Axis {
     #[serde(rename = "x", alias = "X")]
@@ -139,7 +139,7 @@ impl std::fmt::Display for SignedAxis {
     }
 }
 
-/// How pose calibration finds the subject's heading (METHOD.md section 9).
+/// How pose calibration finds the subject's heading (docs/method.md section 14).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PoseSetup {
@@ -287,6 +287,49 @@ pub struct Model {
     /// stick figures. Unit-free (normalised on use).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub segment_direction: BTreeMap<String, [f64; 3]>,
+    /// Coordinates of an optical reference mapped to joint axes: key an
+    /// OpenSim `.mot` column (`knee_angle_r`) or a C3D point's component
+    /// (`RKneeAngles.x`), value `[-]<joint>.<axis>` (`r_knee.y`; `-` when the
+    /// reference counts the other way). Degrees either side.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub reference_coordinates: BTreeMap<String, String>,
+}
+
+/// Where a reference coordinate goes: a joint's axis, and the sign that turns
+/// the reference's value into the joint angle.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ReferenceTarget {
+    pub joint: String,
+    pub axis: Axis,
+    /// True when the joint angle is minus the reference's value.
+    pub negated: bool,
+}
+
+impl std::str::FromStr for ReferenceTarget {
+    type Err = String;
+    /// `[-|+]<joint>.<x|y|z>`.
+    fn from_str(s: &str) -> Result<ReferenceTarget, String> {
+        let t = s.trim();
+        let (negated, rest) = match t.as_bytes().first() {
+            Some(b'-') => (true, &t[1..]),
+            Some(b'+') => (false, &t[1..]),
+            _ => (false, t),
+        };
+        let (joint, axis) = rest
+            .rsplit_once('.')
+            .ok_or_else(|| format!("'{s}': expected [-]<joint>.<x|y|z>, e.g. -r_hip.y"))?;
+        let axis = match axis.to_ascii_lowercase().as_str() {
+            "x" => Axis::X,
+            "y" => Axis::Y,
+            "z" => Axis::Z,
+            _ => return Err(format!("'{s}': the axis must be x, y or z")),
+        };
+        Ok(ReferenceTarget {
+            joint: joint.to_string(),
+            axis,
+            negated,
+        })
+    }
 }
 
 /// Why a model file was rejected.
@@ -449,6 +492,17 @@ impl Model {
                 ));
             }
         }
+        for (coordinate, target) in &self.reference_coordinates {
+            let t: ReferenceTarget = target
+                .parse()
+                .map_err(|e| format!("reference_coordinates.{coordinate}: {e}"))?;
+            if self.joint(&t.joint).is_none() {
+                return Err(format!(
+                    "reference_coordinates.{coordinate}: joint '{}' is not in the model",
+                    t.joint
+                ));
+            }
+        }
         for (alias, canon) in &self.aliases {
             if !imus.contains(canon.as_str()) {
                 return Err(format!("alias '{alias}' points to unknown IMU '{canon}'"));
@@ -476,6 +530,18 @@ impl Model {
                     .map(|(_, c)| c)
             })
             .map(String::as_str)
+    }
+
+    /// The joint axis a reference coordinate maps to (see
+    /// [`Model::reference_coordinates`]); exact name, else any case.
+    pub fn reference_target(&self, coordinate: &str) -> Option<ReferenceTarget> {
+        let target = self.reference_coordinates.get(coordinate).or_else(|| {
+            self.reference_coordinates
+                .iter()
+                .find(|(k, _)| k.eq_ignore_ascii_case(coordinate))
+                .map(|(_, v)| v)
+        })?;
+        target.parse().ok()
     }
 
     /// The inverse-kinematics weight of an IMU (1 unless the model says otherwise).

@@ -1,5 +1,5 @@
-//! Pose calibration with heading correction (METHOD.md section 9; OpenSense's
-//! IMU placer, seed 004).
+//! Pose calibration with heading correction (docs/method.md section 14; OpenSense's
+//! IMU placer, Lavikainen et al.).
 //!
 //! At a chosen instant (or averaged over a chosen span) the subject holds the
 //! model's default pose. First every IMU is rotated about the global vertical
@@ -271,6 +271,8 @@ pub fn calibrate(
         },
     ))
 }
+
+pub mod convention;
 
 #[cfg(test)]
 mod tests;

@@ -62,6 +62,9 @@ pub struct TrialReport {
     /// Orientation jumps over `glitch_deg` (reported, not smoothed).
     #[serde(default)]
     pub glitches: Vec<Glitch>,
+    /// Scores against an optical reference (`report --reference`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<crate::reference::ReferenceReport>,
 }
 
 impl TrialReport {
@@ -130,6 +133,7 @@ impl ReportInput<'_> {
             },
             glitch_deg: DEFAULT_GLITCH_DEG,
             glitches: glitches(t, DEFAULT_GLITCH_DEG),
+            reference: None,
         }
     }
 

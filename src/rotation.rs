@@ -1,4 +1,4 @@
-//! Rotations: unit quaternions, Z-Y-X Euler angles, slerp (METHOD.md section 1 and 4).
+//! Rotations: unit quaternions, Z-Y-X Euler angles, slerp (docs/method.md sections 2, 7).
 //!
 //! Quaternions are Hamilton, scalar first (`[w, x, y, z]`), unit norm. An IMU's
 //! orientation `G_R_imu` maps vectors from the sensor frame into the global frame G.
@@ -29,7 +29,7 @@ pub fn canonical(q: &Quat) -> Quat {
     }
 }
 
-/// Z-Y-X Euler angles `[x, y, z]` (degrees) of the rotation `q` (METHOD.md section 1):
+/// Z-Y-X Euler angles `[x, y, z]` (degrees) of the rotation `q` (docs/method.md section 2.3):
 /// `theta = -asin(R20)`, `phi = atan2(R21, R22)`, `psi = atan2(R10, R00)`.
 pub fn euler_zyx_deg(q: &Quat) -> [f64; 3] {
     let (w, x, y, z) = (q.w, q.i, q.j, q.k);
@@ -79,7 +79,7 @@ pub fn wrap180(a: f64) -> f64 {
 /// Shorter-arc spherical linear interpolation from `q0` (f = 0) to `q1` (f = 1).
 ///
 /// Falls back to normalised linear interpolation when the two nearly coincide
-/// (dot product above 0.9995), as METHOD.md section 4 asks.
+/// (dot product above 0.9995), as docs/method.md section 7 says.
 pub fn slerp(q0: &Quat, q1: &Quat, f: f64) -> Quat {
     let a = q0.into_inner();
     let mut b = q1.into_inner();

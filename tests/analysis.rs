@@ -1,5 +1,5 @@
 //! Limit suggestions and centroids against the generator's truth, and the
-//! structure of exported figures (issue 7 part A).
+//! structure of exported figures.
 //!
 //! The clean trials are `full_body_swing` simulations (src/simulate/swing.rs):
 //! every joint axis swings as one sinusoid over a known range, so the true

@@ -1,5 +1,5 @@
 //! The source's baselines against the ACM on simulated joints whose truth is
-//! known (issue 5; thesis section 4.1 for the knee, Mueller et al. 2017 for the
+//! known (thesis section 4.1 for the knee, Mueller et al. 2017 for the
 //! elbow).
 //!
 //! The knee trials are noise-free, so every figure is the method's own. Rivest

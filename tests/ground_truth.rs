@@ -1,8 +1,8 @@
-//! The engine against simulated trials whose truth is known (issue 3).
+//! The engine against simulated trials whose truth is known.
 //!
 //! Tolerances: the knee trials are noise-free, so the only error left is the
 //! method's own (lambda1 stops a correction at the limit); 0.05 deg per sample
-//! of excursion and 2 deg of flexion range are the figures the issue names. The
+//! of excursion and 2 deg of flexion range are the acceptance figures. The
 //! full-body figures compare variants on the same data, so noise cancels out.
 
 use acm_workbench::acm::{correct_trial, Correction, RunControl, Variant};

@@ -1,4 +1,4 @@
-//! The heading-drift variants against simulated truth (issue 9).
+//! The heading-drift variants against simulated truth (docs/method.md section 10).
 //!
 //! Heading drift (a rotation about the global vertical, what magnetic
 //! disturbance and gyroscope bias do) and sensor slippage (a slow rotation in
@@ -7,7 +7,7 @@
 //! each variant pair (source model vs heading model, without and with the
 //! centroid term) is compared per joint against the true joint angles.
 //!
-//! Tolerances: the issue's figures (30% median reduction on the joints touching
+//! Tolerances: the acceptance figures (30% median reduction on the joints touching
 //! a drifting IMU, no other joint worse by more than 0.5 deg, each drifting
 //! IMU's own drift rate within 20%), asserted for both pairs on the preset
 //! `full_body_drift` trial and on a second body. Both variants of a pair see
@@ -166,7 +166,7 @@ fn within_20_percent(rate: f64, d: &HeadingDrift) -> bool {
     (rate - d.rate_deg_s).abs() <= 0.2 * d.rate_deg_s.abs()
 }
 
-/// Checks the issue's figures on one trial; returns the heading-model run.
+/// Checks the acceptance figures on one trial; returns the heading-model run.
 fn check_drift_case(sim: &Simulated, drifts: &[HeadingDrift], pair: [Variant; 2]) -> Correction {
     let imus: Vec<&str> = drifts.iter().map(|d| d.imu.as_str()).collect();
     let (rows, heading_run) = compare(sim, &imus, pair);

@@ -232,15 +232,64 @@ fn xsens_exports_align_on_wrapped_counters_through_the_mapping() {
 }
 
 #[test]
-fn folder_without_mapping_names_sensors_by_serial() {
+fn folder_without_mapping_is_an_error_that_shows_the_mapping_to_write() {
     let dir = tempfile::tempdir().unwrap();
     let sensors = sensors();
     write_recording(dir.path(), "data", &sensors, None);
     std::fs::remove_file(dir.path().join("myIMUMappings.xml")).unwrap();
+    let folder = dir.path().join("data");
     let model = Model::builtin("opensense_lower").unwrap();
-    let trial = read_trial(&dir.path().join("data"), &model).unwrap();
+    let e = read_trial(&folder, &model).unwrap_err();
+    for serial in ["00B42279", "00B4227C", "00B4227D"] {
+        assert!(e.message.contains(serial), "{e}");
+        assert!(
+            e.message
+                .contains(&format!("<ExperimentalSensor name=\"_{serial}\">")),
+            "{e}"
+        );
+    }
+    assert!(
+        e.message
+            .contains("<trial_prefix>MT_TEST-001</trial_prefix>")
+            && e.message.contains("pelvis_imu"),
+        "{e}"
+    );
+    // The command line says so with exit code 3 (malformed input).
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_acmw"))
+        .args(["report", "-q"])
+        .arg(&folder)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("00B4227D") && stderr.contains("myIMUMappings.xml"),
+        "{stderr}"
+    );
+    // Writing the XML the message shows (names filled in) makes the folder a trial.
+    let xml_start = e.message.find("<?xml").unwrap();
+    let mut xml = e.message[xml_start..].to_string();
+    for s in &sensors {
+        xml = xml.replacen(
+            "<name_in_model>?</name_in_model>",
+            &format!("<name_in_model>{}</name_in_model>", s.name),
+            1,
+        );
+    }
+    std::fs::write(folder.join("myIMUMappings.xml"), xml).unwrap();
+    let trial = read_trial(&folder, &model).unwrap();
     let names: Vec<&str> = trial.imus.iter().map(|s| s.name.as_str()).collect();
-    assert_eq!(names, ["00B42279", "00B4227C", "00B4227D"]);
+    assert_eq!(names, ["pelvis_imu", "femur_r_imu", "tibia_r_imu"]);
+    // A model that knows the serials (aliases) reads the folder without a mapping.
+    std::fs::remove_file(folder.join("myIMUMappings.xml")).unwrap();
+    let aliased = Model::from_toml(
+        "name = \"lab\"\nbase = \"pelvis\"\nimus = [\"pelvis\", \"thigh\"]\n[[joint]]\nname = \"r_hip\"\nkind = \"hip\"\nproximal = \"pelvis\"\ndistal = \"thigh\"\n[aliases]\n00B42279 = \"pelvis\"\n00B4227C = \"thigh\"\n",
+        "lab.toml",
+    )
+    .unwrap();
+    let trial = read_trial(&folder, &aliased).unwrap();
+    let names: Vec<&str> = trial.imus.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["pelvis", "thigh", "00B4227D"]);
     // No rotation without a mapping: the Xsens frame as exported.
     let i = sensors[0]
         .counters
@@ -248,10 +297,226 @@ fn folder_without_mapping_names_sensors_by_serial() {
         .position(|&c| c == 65533)
         .unwrap();
     assert_quat_eq(&trial.imus[0].orientation[0], &sensors[0].qs[i], "pelvis");
-    assert!(trial
-        .warnings
+}
+
+/// The export's text with another separator (and, for semicolons, decimal commas).
+fn with_delimiter(text: &str, sep: char) -> String {
+    text.lines()
+        .map(|l| {
+            if l.starts_with("//") {
+                l.to_string()
+            } else if sep == ';' {
+                l.replace('.', ",").replace('\t', ";")
+            } else {
+                l.replace('\t', &sep.to_string())
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The export with its columns in reverse order, older header spellings
+/// (`Counter`, `q0..q3`) and no `SampleTimeFine`/`Year` columns.
+fn reordered(text: &str) -> String {
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .filter(|l| !l.starts_with("//"))
+        .map(|l| l.split('\t').collect())
+        .collect();
+    let keep: Vec<usize> = (0..rows[0].len())
+        .filter(|&k| !["SampleTimeFine", "Year"].contains(&rows[0][k]))
+        .rev()
+        .collect();
+    let mut out: Vec<String> = text
+        .lines()
+        .filter(|l| l.starts_with("//"))
+        .map(str::to_string)
+        .collect();
+    for (n, row) in rows.iter().enumerate() {
+        let cells: Vec<String> = keep
+            .iter()
+            .map(|&k| {
+                let c = row[k];
+                if n > 0 {
+                    return c.to_string();
+                }
+                match c {
+                    "PacketCounter" => "Counter".to_string(),
+                    c if c.starts_with("Quat_") => c.trim_start_matches("Quat_").to_string(),
+                    c => c.to_string(),
+                }
+            })
+            .collect();
+        out.push(cells.join("\t"));
+    }
+    out.join("\n")
+}
+
+/// A rewrite of an export's text.
+type Rewrite = fn(&str) -> String;
+
+#[test]
+fn exports_read_alike_in_any_delimiter_column_order_and_spelling() {
+    let dir = tempfile::tempdir().unwrap();
+    let sensors = sensors();
+    write_recording(dir.path(), "IMUData", &sensors, None);
+    let model = Model::builtin("opensense_lower").unwrap();
+    let xml = dir.path().join("myIMUMappings.xml");
+    let tab = read_trial(&xml, &model).unwrap();
+    let data = dir.path().join("IMUData");
+    let originals: Vec<(std::path::PathBuf, String)> = sensors
         .iter()
-        .any(|w| w.contains("'00B42279'") && w.contains("not in model")));
+        .map(|s| {
+            let f = data.join(format!("MT_TEST-001_{}.txt", s.serial));
+            let t = std::fs::read_to_string(&f).unwrap();
+            (f, t)
+        })
+        .collect();
+    let variants: [(&str, Rewrite); 3] = [
+        ("comma", |t| with_delimiter(t, ',')),
+        ("semicolon", |t| with_delimiter(t, ';')),
+        ("reordered", reordered),
+    ];
+    for (what, rewrite) in variants {
+        for (f, t) in &originals {
+            std::fs::write(f, rewrite(t)).unwrap();
+        }
+        let other = read_trial(&xml, &model).unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert_eq!(other.time_s, tab.time_s, "{what}");
+        assert_eq!(other.imus, tab.imus, "{what}: bit for bit");
+        assert_eq!(other.warnings, tab.warnings, "{what}");
+    }
+    // Saved as .csv (comma-separated) under the mapping's names: found and read alike.
+    for (f, t) in &originals {
+        std::fs::remove_file(f).unwrap();
+        std::fs::write(f.with_extension("csv"), with_delimiter(t, ',')).unwrap();
+    }
+    let csv = read_trial(&xml, &model).unwrap();
+    assert_eq!(
+        (csv.time_s.clone(), csv.imus.clone()),
+        (tab.time_s.clone(), tab.imus.clone())
+    );
+    for (f, t) in &originals {
+        std::fs::remove_file(f.with_extension("csv")).unwrap();
+        std::fs::write(f, t).unwrap();
+    }
+    // A semicolon export says where a bad cell is, naming the separator.
+    let (f, t) = &originals[0];
+    let bad = with_delimiter(t, ';').replacen("\n00000;", "\n00000", 1);
+    std::fs::write(f, bad).unwrap();
+    let e = read_trial(&xml, &model).unwrap_err();
+    assert!(e.message.contains("semicolon-separated"), "{e}");
+}
+
+#[test]
+fn a_single_export_is_a_trial_of_one_imu() {
+    let dir = tempfile::tempdir().unwrap();
+    let sensors = sensors();
+    write_recording(dir.path(), "IMUData", &sensors, None);
+    let model = Model::builtin("opensense_lower").unwrap();
+    let file = dir.path().join("IMUData/MT_TEST-001_00B4227C.txt");
+    assert!(is_trial_path(&file));
+    assert_eq!(detect_format(&file).unwrap(), (TrialFormat::Xsens, false));
+    // Named by the mapping in the folder above, all its own packets kept.
+    let one = read_trial(&file, &model).unwrap();
+    assert_eq!(one.imus.len(), 1);
+    assert_eq!(one.imus[0].name, "femur_r_imu");
+    assert_eq!(one.len(), sensors[1].counters.len());
+    for (q, want) in one.imus[0].orientation.iter().zip(&sensors[1].qs) {
+        assert_quat_eq(q, want, "femur");
+    }
+    // Without a mapping: by its serial, with a warning, and no error.
+    std::fs::remove_file(dir.path().join("myIMUMappings.xml")).unwrap();
+    let one = read_trial(&file, &model).unwrap();
+    assert_eq!(one.imus[0].name, "00B4227C");
+    // Saved as .csv by the lab: read as an export, not a canonical CSV.
+    let csv = dir.path().join("femur.csv");
+    std::fs::write(
+        &csv,
+        with_delimiter(&std::fs::read_to_string(&file).unwrap(), ','),
+    )
+    .unwrap();
+    assert_eq!(detect_format(&csv).unwrap(), (TrialFormat::Xsens, false));
+    let from_csv = read_trial(&csv, &model).unwrap();
+    assert_eq!(from_csv.imus[0].orientation, one.imus[0].orientation);
+    assert_eq!(from_csv.imus[0].name, "femur");
+}
+
+#[test]
+fn rate_comes_from_sample_time_fine_without_an_update_rate_comment() {
+    let dir = tempfile::tempdir().unwrap();
+    let qs = orientations(20, 9);
+    let mut text = String::from("// MT Manager version: 2022.2.0\nPacketCounter,SampleTimeFine,Quat_q0,Quat_q1,Quat_q2,Quat_q3\n");
+    for (k, q) in qs.iter().enumerate() {
+        // 60 Hz: 166.67 ticks of 100 us per packet, printed as whole ticks.
+        let ticks = (1_000_000.0 + k as f64 * 10_000.0 / 60.0).round();
+        let _ = writeln!(text, "{},{ticks},{},{},{},{}", 100 + k, q.w, q.i, q.j, q.k);
+    }
+    let file = dir.path().join("MT_1_00B4AAAA.txt");
+    std::fs::write(&file, &text).unwrap();
+    let model = Model::builtin("opensense_lower").unwrap();
+    let trial = read_trial(&file, &model).unwrap();
+    // The median of 166/167 ticks per packet.
+    let rate = trial.rate_hz();
+    assert!(
+        (rate - 10_000.0 / 167.0).abs() < 1e-9 || (rate - 10_000.0 / 166.0).abs() < 1e-9,
+        "{rate}"
+    );
+    // Neither a comment nor sample times: a located error.
+    let bare: String = text
+        .replace(",SampleTimeFine", "")
+        .lines()
+        .map(|l| {
+            if l.starts_with("//") || l.starts_with("Packet") {
+                return format!("{l}\n");
+            }
+            let mut c: Vec<&str> = l.split(',').collect();
+            c.remove(1);
+            format!("{}\n", c.join(","))
+        })
+        .collect();
+    std::fs::write(&file, bare).unwrap();
+    let e = read_trial(&file, &model).unwrap_err();
+    assert!(
+        e.message.contains("no update rate") && e.message.contains("SampleTimeFine"),
+        "{e}"
+    );
+}
+
+#[test]
+fn comment_lines_above_a_csv_header_are_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = Model::builtin("opensense_lower").unwrap();
+    let quat = dir.path().join("q.csv");
+    std::fs::write(
+        &quat,
+        "# exported by the lab\n# subject 3\ntime,pelvis_imu_qw,pelvis_imu_qx,pelvis_imu_qy,pelvis_imu_qz\n0,1,0,0,0\n0.01,1,0,0,0\n",
+    )
+    .unwrap();
+    assert_eq!(detect_format(&quat).unwrap(), (TrialFormat::QuatCsv, false));
+    let t = read_trial(&quat, &model).unwrap();
+    assert_eq!((t.len(), t.imus[0].name.as_str()), (2, "pelvis_imu"));
+    let euler = dir.path().join("e.csv");
+    std::fs::write(
+        &euler,
+        "#degrees\n\ntime,pelvis_imu_roll,pelvis_imu_pitch,pelvis_imu_yaw\n0,0,0,90\n0.01,0,0,90\n",
+    )
+    .unwrap();
+    assert_eq!(
+        detect_format(&euler).unwrap(),
+        (TrialFormat::EulerCsv, false)
+    );
+    let t = read_trial(&euler, &model).unwrap();
+    let [_, _, yaw] = euler_zyx_deg(&t.imus[0].orientation[1]);
+    assert!((yaw - 90.0).abs() < 1e-9);
+    // A bad row after comments is located on its own line.
+    std::fs::write(
+        &euler,
+        "#a\n#b\ntime,pelvis_imu_roll,pelvis_imu_pitch,pelvis_imu_yaw\n0,0,x,90\n",
+    )
+    .unwrap();
+    let e = read_trial(&euler, &model).unwrap_err();
+    assert_eq!((e.line, e.column), (4, 3), "{e}");
 }
 
 #[test]

@@ -1,5 +1,5 @@
 //! The Mueller et al. (2017) elbow baseline with gyroscopes against the same
-//! trial with rates derived from the orientations (issue 5), on simulated
+//! trial with rates derived from the orientations, on simulated
 //! elbows whose axes and angles are known: a regular 50 Hz trial, and a
 //! thinned, irregular one with a gap, where central differences of the
 //! orientations are coarse and gyros are not.
@@ -105,7 +105,7 @@ fn without_gyros(trial: &Trial) -> Trial {
 /// Measured when written (printed with --nocapture): gyros axis errors
 /// 0.11 / 0.04 deg, flexion RMS 0.41 deg; orientations 0.51 / 0.25 deg, 0.61
 /// deg. Both must recover the axes within 3 deg and the flexion within 3 deg
-/// RMS (the issue's bar); the gyros' axes within 0.5 deg (4 times the
+/// RMS (the acceptance bar); the gyros' axes within 0.5 deg (4 times the
 /// measured). What flexion error is left is mostly the orientation noise of
 /// the two sensors (0.5 deg RMS each), which no rate source removes.
 #[test]
@@ -151,7 +151,7 @@ fn thinned(sim: &Simulated, every: usize, gap_s: (f64, f64), seed: u64) -> Vec<u
 /// Measured when written (printed with --nocapture), mean over the seeds of
 /// the proximal / distal axis error: gyros 0.43 / 0.12 deg (worst 1.14),
 /// orientations 1.15 / 0.33 deg (worst 2.32). Per seed the gyros win but
-/// once (seed 1: 1.14 vs 0.63 deg on the proximal axis). Bounds: every gyro run within the issue's 3 deg (axes and
+/// once (seed 1: 1.14 vs 0.63 deg on the proximal axis). Bounds: every gyro run within the 3 deg bar (axes and
 /// flexion RMS) and its axes within 1.5 deg; over the seeds the gyros' mean
 /// axis error at most half the orientations' (measured 0.37 of it).
 #[test]

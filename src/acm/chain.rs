@@ -1,4 +1,4 @@
-//! Correcting a whole trial down the model's chain (METHOD.md sections 2-4).
+//! Correcting a whole trial down the model's chain (docs/method.md section 8).
 //!
 //! Joints are taken in the model's correction order. Joints at the same depth of
 //! the chain never depend on each other and run in parallel, as do the windows
@@ -51,10 +51,39 @@ pub fn correct_trial(
     variant: Variant,
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
-    if variant == Variant::Ik {
-        return crate::ik::correct_trial(trial, model, settings, control);
+    match variant {
+        Variant::Ik => crate::ik::correct_trial(trial, model, settings, control),
+        Variant::None => Ok(uncorrected(trial, model, limits, settings)),
+        _ => run(trial, model, limits, settings, variant, None, control),
     }
-    run(trial, model, limits, settings, variant, None, control)
+}
+
+/// The `none` variant: the trial as it is, every joint left uncorrected (the
+/// joints that could not be corrected in any variant are listed as skipped).
+fn uncorrected(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    settings: &Settings,
+) -> Correction {
+    Correction {
+        headings: Vec::new(),
+        variant: Variant::None,
+        settings: *settings,
+        corrected: trial.clone(),
+        joints: Vec::new(),
+        skipped: model
+            .joints
+            .iter()
+            .filter_map(|j| {
+                skip_reason(trial, j, limits).map(|reason| SkippedJoint {
+                    joint: j.name.clone(),
+                    reason,
+                })
+            })
+            .collect(),
+        ik: None,
+    }
 }
 
 /// Re-corrects the named joints and everything below them, reusing `previous`
@@ -71,8 +100,9 @@ pub fn recorrect(
     joints: &[&str],
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
-    if previous.variant == Variant::Ik {
-        // Inverse kinematics does not read the limit table or the settings.
+    if matches!(previous.variant, Variant::Ik | Variant::None) {
+        // Inverse kinematics and no correction do not read the limit table
+        // or the settings.
         return Ok(previous.clone());
     }
     let mut redo = BTreeSet::new();

@@ -1,4 +1,4 @@
-//! The ACM cost of one joint over one window (METHOD.md section 3, eq. 3.9 and 3.16).
+//! The ACM cost of one joint over one window (docs/method.md section 5; thesis eq. 3.9, 3.16).
 //!
 //! `e(C) = (1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i) + lambda1 * angle(C)`
 //! where the excursions are of the Z-Y-X angles (degrees) of `Rt_i = Rm_i * C`,
@@ -150,7 +150,7 @@ impl PitchRange {
     }
 }
 
-/// The per-sample terms of a joint's limits (METHOD.md section 3): the
+/// The per-sample terms of a joint's limits (docs/method.md section 5): the
 /// excursions beyond the three ranges and the centroid term.
 #[derive(Debug, Clone)]
 pub(super) struct LimitTerms {

@@ -8,7 +8,7 @@
 //! strap's misalignment is fixed in the sensor frame; this is that physics, with
 //! 3 + K degrees of freedom per IMU where the `drift` variant has 3K.
 //!
-//! The objective is the sum of the window costs of METHOD.md section 3 with the
+//! The objective is the sum of the window costs of docs/method.md section 5 with the
 //! heading term, each window at its own constant heading:
 //! `J(C, h) = sum_k e_k(C, h_k)`,
 //! `e_k = (1/n_k) sum_{i in k} (Ex + Ey + Ez + lambda2 RMSq)(P_i'^T R_up(-h_k) D_i C)
@@ -380,8 +380,8 @@ pub(super) fn line_search(
 }
 
 /// The heading at each sample: `h_1` before the first centre, `h_N` from the last
-/// centre on, linear between neighbouring centres (the slerp of METHOD.md
-/// section 4 for rotations about one axis). Times relative to the first sample.
+/// centre on, linear between neighbouring centres (the slerp of docs/method.md
+/// section 7 for rotations about one axis). Times relative to the first sample.
 pub fn heading_series(time_s: &[f64], centres_s: &[f64], headings_deg: &[f64]) -> Vec<f64> {
     assert_eq!(centres_s.len(), headings_deg.len());
     let Some(&t0) = time_s.first() else {

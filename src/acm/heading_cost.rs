@@ -10,7 +10,7 @@
 //! are kept. The quaternion of `Rt(h)` is `cos(h/2) a + sin(h/2) b` likewise, so
 //! the centroid term costs two dot products per sample prepared once.
 //!
-//! The value is the window cost of METHOD.md section 3 with the heading term:
+//! The value is the window cost of docs/method.md section 5 with the heading term:
 //! `e(C, h) = (1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i)
 //!            + lambda1 * angle(C) + lambda1 * |h|` (degrees).
 

@@ -1,4 +1,4 @@
-//! The Anatomical Constraint Method (METHOD.md sections 3-4).
+//! The Anatomical Constraint Method (docs/method.md sections 5-10).
 //!
 //! Per joint, the correction C of the distal IMU keeps the joint's Z-Y-X angles
 //! inside their limits (and, with a centroid, near it) at the least rotation.
@@ -59,11 +59,14 @@ pub enum Variant {
     /// IMU inverse kinematics (`crate::ik`): joint coordinates with the
     /// model's degrees of freedom and hard limits; not the ACM.
     Ik,
+    /// No correction: the trial as read, after any pose or functional
+    /// calibration (the step before every other variant).
+    None,
 }
 
 impl Variant {
     /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 8] = [
+    pub const ALL: [Variant; 9] = [
         Variant::Basic,
         Variant::Drift,
         Variant::DriftCentroid,
@@ -72,6 +75,7 @@ impl Variant {
         Variant::Rivest,
         Variant::Mueller,
         Variant::Ik,
+        Variant::None,
     ];
 
     /// The name used on the command line, in files and on screen.
@@ -85,6 +89,7 @@ impl Variant {
             Variant::DriftHeading => "drift-heading",
             Variant::DriftHeadingCentroid => "drift-heading-centroid",
             Variant::Ik => "ik",
+            Variant::None => "none",
         }
     }
 
@@ -95,7 +100,7 @@ impl Variant {
 
     /// Solves per window (true) or once for the whole trial (false).
     pub fn windowed(self) -> bool {
-        !matches!(self, Variant::Basic | Variant::Ik)
+        !matches!(self, Variant::Basic | Variant::Ik | Variant::None)
     }
 
     /// Uses the table's centroid term.

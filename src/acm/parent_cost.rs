@@ -9,8 +9,8 @@
 //! of `C_p^T` and the columns of `B`; the centroid term uses
 //! `(c_p^-1 b) . q_c = b . (c_p q_c)`, one 4-vector per evaluation.
 //!
-//! The value is the mean per-sample part of the window cost of METHOD.md
-//! section 3, without any `lambda1` term (the penalties of `C_p` and of the
+//! The value is the mean per-sample part of the window cost of docs/method.md
+//! section 5, without any `lambda1` term (the penalties of `C_p` and of the
 //! distal IMU's correction are counted by the caller, once each):
 //! `(1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i)`, degrees.
 

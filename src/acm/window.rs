@@ -1,4 +1,4 @@
-//! Drift windows and the time-dependent correction between them (METHOD.md section 4).
+//! Drift windows and the time-dependent correction between them (docs/method.md section 7).
 //!
 //! Times are seconds. Window bounds are relative to the first sample; sample
 //! indices are into the trial's time vector.

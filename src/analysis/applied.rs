@@ -1,7 +1,7 @@
-//! The applied correction over time (issue 7, view 4): the rotation `C(t)` the
+//! The applied correction over time (the `a` view): the rotation `C(t)` the
 //! engine applied to a joint's distal IMU, `G_R_dist' = G_R_dist C(t)`, as its
 //! angle and per-axis components, with the window centres it was slerped
-//! between (METHOD.md section 4).
+//! between (docs/method.md section 7).
 //!
 //! Frames and units: `C(t)` is in the distal IMU's sensor frame; components are
 //! the rotation vector (axis times angle) in that frame, degrees; times are

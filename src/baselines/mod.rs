@@ -1,5 +1,5 @@
-//! The single-joint methods the source compares the ACM against (METHOD.md
-//! section 7): Rivest (2005) for knees, Mueller et al. (2017) for elbows.
+//! The single-joint methods the source compares the ACM against (docs/method.md
+//! section 11): Rivest (2005) for knees, Mueller et al. (2017) for elbows.
 //!
 //! Each runs as a variant of the whole-trial correction (`rivest`, `mueller`):
 //! the joints of its kind get the baseline, every other joint the ACM's

@@ -1,5 +1,5 @@
 //! Mueller et al. (2017) hinge-axis estimation for two-degree-of-freedom joints
-//! such as the elbow (thesis eq. 2.20-2.32, METHOD.md section 7).
+//! such as the elbow (thesis eq. 2.20-2.32, docs/method.md section 11.2).
 //!
 //! In the Z-Y-X convention of the workbench a joint rotation
 //! `R = Rz(psi) Ry(theta) Rx(phi)` with no Y movement turns about an axis fixed

@@ -1,5 +1,5 @@
 //! Rivest (2005) knee correction, as the source applies it (thesis eq. 2.10-2.19,
-//! METHOD.md section 7).
+//! docs/method.md section 11.1).
 //!
 //! The knee should neither ab/adduct nor rotate. Small misalignments of the thigh
 //! IMU (corrections `a1`, `a2`, rotated with flexion) and of the calf IMU

@@ -1,5 +1,5 @@
 //! One movement's axis estimate and its reliability (Ricci et al. 2014,
-//! section 2.2.3, eq. 1-2; METHOD.md section 8).
+//! section 2.2.3, eq. 1-2; docs/method.md section 13).
 //!
 //! The N readings (accelerometer for a still posture, gyroscope for a
 //! mono-axial movement; sensor frame) are normalised to unit length and stacked

@@ -1,4 +1,4 @@
-//! Functional calibration after Ricci et al. 2014 (METHOD.md section 8): from a
+//! Functional calibration after Ricci et al. 2014 (docs/method.md section 13): from a
 //! recording of still postures and mono-axial movements, the rotation between
 //! each IMU's sensor frame (SF) and the functional frame (FF) of its segment.
 //!

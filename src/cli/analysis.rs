@@ -67,7 +67,8 @@ pub struct TableArgs {
 
 #[derive(Debug, Args)]
 pub struct SuggestArgs {
-    /// Clean trials (no obvious drift) to take the ranges from.
+    /// Clean trials (no obvious drift) to take the ranges from (any input
+    /// `acmw correct` reads: CSV, `.sto`, Xsens exports, a folder or mapping XML).
     #[arg(required = true)]
     pub trials: Vec<PathBuf>,
     /// Where to write the suggested table (never the current table's file).
@@ -84,7 +85,8 @@ pub struct SuggestArgs {
 
 #[derive(Debug, Args)]
 pub struct CentroidArgs {
-    /// Trials with little drift to take the mean angles from.
+    /// Trials with little drift to take the mean angles from (any input
+    /// `acmw correct` reads: CSV, `.sto`, Xsens exports, a folder or mapping XML).
     #[arg(required = true)]
     pub trials: Vec<PathBuf>,
     /// Where to write the centroid table (CSV) [default: print it only].

@@ -49,7 +49,12 @@ pub struct PoseArgs {
     pub pose_calibration: Option<PoseTime>,
     /// The base IMU's sensor axis that points forward in the calibration pose
     /// (+x, -x, +y, -y, +z, -z) [default: the model's `pose.base_forward`].
-    #[arg(long, value_name = "AXIS", requires = "pose_calibration")]
+    #[arg(
+        long,
+        value_name = "AXIS",
+        requires = "pose_calibration",
+        allow_hyphen_values = true
+    )]
     pub base_forward: Option<SignedAxis>,
 }
 

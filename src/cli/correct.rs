@@ -12,7 +12,11 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct CorrectArgs {
-    /// The trial to correct (.csv, .sto, optionally .gz).
+    /// The trial: a canonical CSV (`time,<imu>_qw,_qx,_qy,_qz,...`; `#`
+    /// comment lines above the header), an Euler CSV (`time,<imu>_roll,_pitch,_yaw,...`,
+    /// degrees), an OpenSim `.sto` (each optionally `.gz`); an Xsens MT Manager
+    /// export (`.txt` or `.csv`, tab, comma or semicolon separated: a trial of
+    /// one IMU); a folder of such exports; or an OpenSense mapping `.xml` naming them.
     pub input: PathBuf,
     /// Output trial [default: corrected/<name>.<variant>.<ext> beside the input].
     #[arg(short, long)]
@@ -111,7 +115,15 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             args.quiet,
         )?,
     };
-    let (trial, pose) = apply_pose(trial, &ctx.model, pose.as_ref(), &args.input)?;
+    let (mut trial, pose) = apply_pose(trial, &ctx.model, pose.as_ref(), &args.input)?;
+    // Convention checks: mirrored or offset angles against the table.
+    let checks = acm_workbench::pose::convention::check_conventions(
+        &trial,
+        &ctx.model,
+        &ctx.limits,
+        pose.is_some(),
+    );
+    trial.warnings.extend(checks);
     if !args.quiet {
         for w in &trial.warnings {
             eprintln!("warning: {w}");

@@ -78,7 +78,7 @@ pub struct Cli {
 pub enum Command {
     /// Correct a trial and write the corrected trial plus a sidecar JSON.
     Correct(correct::CorrectArgs),
-    /// Print the figures (METHOD.md section 6) before and after each variant.
+    /// Print the figures (docs/method.md section 16) before and after each variant.
     Report(report::ReportArgs),
     /// Simulate a trial with known misalignment and drift, and write its truth beside it.
     Simulate(simulate::SimulateArgs),

@@ -20,7 +20,8 @@ pub struct PlotArgs {
     /// What to draw.
     #[arg(value_enum)]
     pub kind: PlotKind,
-    /// Trials: `traces` draws the first; `histogram` pools them all.
+    /// Trials (any input `acmw correct` reads): `traces` draws the first;
+    /// `histogram` pools them all.
     #[arg(required = true)]
     pub trials: Vec<PathBuf>,
     /// Output file; `.svg` or `.png` picks the format.

@@ -1,7 +1,8 @@
-//! `acmw report`: the METHOD.md section 6 figures before and after each variant.
+//! `acmw report`: the figures of docs/method.md section 16 before and after each variant.
 
 use super::common::{apply_pose, load_context, EngineArgs, PoseArgs, Progress};
-use acm_workbench::acm::{RunControl, Variant};
+use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::reference::{compare, read_reference, CompareOptions};
 use acm_workbench::report::{format_text, ReportInput};
 use acm_workbench::trial::read_trial;
 use acm_workbench::truth::load_truth_beside;
@@ -10,7 +11,11 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct ReportArgs {
-    /// The trial to report on (.csv, .sto, optionally .gz).
+    /// The trial: a canonical CSV (`time,<imu>_qw,_qx,_qy,_qz,...`; `#`
+    /// comment lines above the header), an Euler CSV (`time,<imu>_roll,_pitch,_yaw,...`,
+    /// degrees), an OpenSim `.sto` (each optionally `.gz`); an Xsens MT Manager
+    /// export (`.txt` or `.csv`, tab, comma or semicolon separated: a trial of
+    /// one IMU); a folder of such exports; or an OpenSense mapping `.xml` naming them.
     pub input: PathBuf,
     /// Variants to run and compare (repeatable) [default: all].
     #[arg(long, value_enum)]
@@ -29,9 +34,43 @@ pub struct ReportArgs {
     pub engine: EngineArgs,
     #[command(flatten)]
     pub pose: PoseArgs,
+    /// Score the angles against an optical reference: a CSV
+    /// (`time,<joint>_x,<joint>_y,<joint>_z`, degrees, any subset), an OpenSim
+    /// `.mot` (coordinates mapped to joint axes by the model's
+    /// `[reference_coordinates]`) or a C3D (Plug-in Gait angle points such as
+    /// `LKneeAngles`, mapped the same way).
+    #[arg(long, value_name = "FILE")]
+    pub reference: Option<PathBuf>,
+    /// Start of the span scored against the reference, seconds from the first sample.
+    #[arg(long, value_name = "S", requires = "reference")]
+    pub from: Option<f64>,
+    /// End of the span scored against the reference, seconds from the first sample.
+    #[arg(long, value_name = "S", requires = "reference")]
+    pub to: Option<f64>,
+    /// Search the reference's time lag within +-S seconds [default: 2].
+    #[arg(long, value_name = "S", requires = "reference", value_parser = non_negative_s)]
+    pub max_lag: Option<f64>,
+    /// Use this time lag instead of searching: the reference is read at the
+    /// trial's time + S, both as their files give them (a C3D's from 0).
+    #[arg(
+        long,
+        value_name = "S",
+        requires = "reference",
+        conflicts_with = "max_lag",
+        allow_negative_numbers = true
+    )]
+    pub lag: Option<f64>,
     /// No progress output.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// A finite number of seconds, at least 0.
+fn non_negative_s(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("expected seconds >= 0, found '{s}'")),
+    }
 }
 
 /// A positive, finite angle in degrees.
@@ -56,7 +95,15 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         args.quiet,
     )?;
     let pose_calibration = args.pose.calibration(&ctx.model);
-    let (trial, pose) = apply_pose(trial, &ctx.model, pose_calibration.as_ref(), &args.input)?;
+    let (mut trial, pose) = apply_pose(trial, &ctx.model, pose_calibration.as_ref(), &args.input)?;
+    // Convention checks: mirrored or offset angles against the table.
+    let checks = acm_workbench::pose::convention::check_conventions(
+        &trial,
+        &ctx.model,
+        &ctx.limits,
+        pose.is_some(),
+    );
+    trial.warnings.extend(checks);
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {
             let t = t?;
@@ -89,8 +136,31 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         settings: &ctx.settings,
         truth: truth.as_ref().map(|t| &t.segments),
     };
-    let mut r = input.run(&variants, &control)?;
+    let corrections = variants
+        .iter()
+        .map(|&v| correct_trial(&trial, &ctx.model, &ctx.limits, &ctx.settings, v, &control))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut r = input.report(&corrections);
     r.pose_calibration = pose;
+    if let Some(path) = &args.reference {
+        let reference = read_reference(path, &ctx.model)?;
+        let mut series = vec![("uncorrected".to_string(), &trial)];
+        series.extend(
+            corrections
+                .iter()
+                .map(|c| (c.variant.name().to_string(), &c.corrected)),
+        );
+        let opts = CompareOptions {
+            max_lag_s: args.max_lag.unwrap_or(CompareOptions::default().max_lag_s),
+            lag_s: args.lag,
+            from_s: args.from,
+            to_s: args.to,
+        };
+        r.reference = Some(
+            compare(&series, &ctx.model, &reference, &opts)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
+        );
+    }
     let glitch_deg = args.glitch_deg.unwrap_or(ctx.glitch_deg);
     if glitch_deg != r.glitch_deg {
         r.set_glitch_threshold(&trial, glitch_deg);
@@ -100,6 +170,10 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
         outln!("{}", serde_json::to_string_pretty(&r)?)?;
     } else {
         out!("{}", format_text(&r))?;
+        if let Some(reference) = &r.reference {
+            outln!()?;
+            out!("{}", acm_workbench::reference::format_text(reference))?;
+        }
     }
     Ok(0)
 }

@@ -133,6 +133,19 @@ pub struct CommonArgs {
     /// simulated again from it when needed (deterministic), which keeps folders small.
     #[arg(long)]
     pub truth_json_only: bool,
+    /// Also write the true joint angles as a reference CSV
+    /// (`time,<joint>_x,<joint>_y,<joint>_z`, degrees) for `acmw report --reference`.
+    #[arg(long, value_name = "FILE.csv")]
+    pub reference_csv: Option<PathBuf>,
+    /// Shift the reference CSV's times by S seconds (a clock that started S
+    /// earlier), to try the lag search.
+    #[arg(
+        long,
+        value_name = "S",
+        requires = "reference_csv",
+        allow_negative_numbers = true
+    )]
+    pub reference_lag: Option<f64>,
 }
 
 fn parse_drift(s: &str) -> Result<HeadingDrift, String> {
@@ -278,6 +291,13 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<i32> {
         None => trial,
     };
     let (truth_csv, truth_json) = save(&trial, &sim.truth, out, common.truth_json_only)?;
+    if let Some(path) = &common.reference_csv {
+        write_reference(&sim.truth, path, common.reference_lag.unwrap_or(0.0))?;
+        outln!(
+            "wrote {} (true joint angles, reference CSV)",
+            path.display()
+        )?;
+    }
 
     outln!(
         "wrote {}: {} IMUs, {} samples ({} s at {} Hz), seed {}, noise {} deg",
@@ -350,6 +370,26 @@ fn save(
         return Ok((csv, json));
     }
     Ok(truth.save_beside(out)?)
+}
+
+/// The truth's joint angles as a reference CSV, times shifted by `lag_s`.
+fn write_reference(truth: &Truth, path: &Path, lag_s: f64) -> anyhow::Result<()> {
+    let model = acm_workbench::model::Model::builtin(simulate::MODEL)?;
+    let mut columns = Vec::new();
+    for joint in &model.joints {
+        let Some(angles) = acm_workbench::metrics::joint_angles(&truth.segments, joint) else {
+            continue;
+        };
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            columns.push((
+                format!("{}_{axis}", joint.name),
+                angles.iter().map(|a| a[k]).collect(),
+            ));
+        }
+    }
+    let time: Vec<f64> = truth.segments.time_s.iter().map(|t| t + lag_s).collect();
+    acm_workbench::reference::write_csv(path, &time, &columns)
+        .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! IMU inverse kinematics (METHOD.md section 9; Lavikainen et al., seed 004).
+//! IMU inverse kinematics (docs/method.md section 15; Lavikainen et al.).
 //!
 //! Per frame, the base rotation and joint coordinates (the moving Z-Y-X axes
 //! each joint declares, inside its hard limits) that minimise the weighted sum

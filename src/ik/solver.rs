@@ -1,4 +1,4 @@
-//! One frame of IMU inverse kinematics (METHOD.md section 9, seed 004): the
+//! One frame of IMU inverse kinematics (docs/method.md section 15): the
 //! base rotation and joint coordinates that minimise `sum_i w_i * x_i^2`, where
 //! `x_i` is the angle of IMU i's orientation error, inside the hard limits.
 //!

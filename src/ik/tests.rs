@@ -41,7 +41,7 @@ fn recovers_reduced_dof_coordinates_from_exact_orientations() {
     assert_eq!(sol.run.coordinates.len(), 30);
     let rms = rms_errors(&sol.run, &sim.coordinates_deg);
     let worst = rms.iter().copied().fold(0.0, f64::max);
-    // The issue asks for 1 deg RMS; exact input and a 1e-8 rad step tolerance
+    // The acceptance bar is 1 deg RMS; exact input and a 1e-8 rad step tolerance
     // leave only round-off, so hold the solver to far less.
     assert!(worst < 1e-4, "worst coordinate RMS error {worst} deg");
     eprintln!("noise-free IK: worst coordinate RMS error {worst:.2e} deg");
@@ -150,7 +150,7 @@ fn ik_variant_trial_shows_the_coordinates_as_joint_angles() {
         let hinge = crate::rotation::quat_axis_angle_deg([0.0, 1.0, 0.0], y);
         assert!(angle_between_deg(&quat_from_euler_zyx_deg(*a), &hinge) < 1e-7);
         // Past 90 deg of flexion the Z-Y-X angles take their other form
-        // (180, 180 - y, 180): the METHOD.md section 1 convention, not IK's.
+        // (180, 180 - y, 180): the Z-Y-X convention's, not IK's.
         if y.abs() < 89.0 {
             assert!(a[0].abs() < 1e-9 && a[2].abs() < 1e-9, "{a:?}");
             assert!((a[1] - y).abs() < 1e-9);

@@ -472,6 +472,13 @@ fn rng(seed: u64, stream: Stream) -> ChaCha8Rng {
 /// Runs a simulation (model `infant13`, limits Table 3-2).
 pub fn simulate(config: &SimConfig) -> Result<Simulated, SimError> {
     let model = Model::builtin(MODEL).map_err(|e| SimError(e.to_string()))?;
+    simulate_with(config, &model)
+}
+
+/// Runs a simulation of `model`'s IMUs (limits Table 3-2). The knee and
+/// elbow kinds simulate their own two or three IMUs, whatever the model.
+pub fn simulate_with(config: &SimConfig, model: &Model) -> Result<Simulated, SimError> {
+    let model = model.clone();
     config.validate(&model)?;
     let n = config.samples();
     let time_s: Vec<f64> = (0..n).map(|i| i as f64 / config.rate_hz).collect();

@@ -34,7 +34,7 @@ pub(crate) mod parse;
 #[cfg(test)]
 mod tests;
 
-use parse::{classify_csv_header, first_nonblank, parse_header, parse_trial, LineIter};
+use parse::{classify_csv_header, first_header, parse_header, parse_trial, LineIter};
 
 /// A cheap look at a trial file: its format and IMUs, without the samples.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -88,27 +88,32 @@ fn kind_or_err(path: &Path) -> Result<(Kind, bool), TrialError> {
     kind_of_name(path).ok_or_else(|| {
         TrialError::file(
             origin_of(path),
-            "unknown trial file type: expected a name ending in .csv, .sto, .csv.gz or .sto.gz",
+            format!(
+                "unknown trial file type: expected {}",
+                super::ACCEPTED_INPUTS
+            ),
         )
     })
 }
 
-/// True when `path` names an Xsens trial: a folder, or an `.xml` mapping file.
+/// True when `path` names an Xsens trial: a folder, an `.xml` mapping file, or
+/// a single export (`.txt`, or a `.csv` that starts like an MT Manager export).
 fn is_xsens_path(path: &Path) -> bool {
     path.is_dir()
         || path
             .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml") || e.eq_ignore_ascii_case("txt"))
+        || super::xsens_trial::is_export_file(path)
 }
 
 /// True when `path` is a trial the workbench lists: a trial file
 /// ([`is_trial_file`]), an OpenSense mapping XML, or a folder of Xsens exports.
 pub fn is_trial_path(path: &Path) -> bool {
-    use super::xsens_trial::{is_export_folder, is_mapping_file};
+    use super::xsens_trial::{is_export_file, is_export_folder, is_mapping_file};
     if path.is_dir() {
         is_export_folder(path)
     } else {
-        is_trial_file(path) || is_mapping_file(path)
+        is_trial_file(path) || is_mapping_file(path) || is_export_file(path)
     }
 }
 
@@ -239,7 +244,7 @@ fn read_head(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> 
             break;
         }
         let line = buf[start..].trim_ascii();
-        if line.is_empty() {
+        if line.is_empty() || (kind == Kind::Csv && line.starts_with(b"#")) {
             continue;
         }
         if ended {
@@ -265,7 +270,7 @@ pub fn detect_format(path: &Path) -> Result<(TrialFormat, bool), TrialError> {
         Kind::Sto => Ok((TrialFormat::Sto, gzip)),
         Kind::Csv => {
             let head = read_head(path, kind, gzip)?;
-            match first_nonblank(&head) {
+            match first_header(&head) {
                 Some(h) => Ok((classify_csv_header(h), gzip)),
                 None => Err(TrialError::at(
                     origin_of(path),
@@ -288,7 +293,7 @@ pub fn read_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
     let (text, stale) = read_text(path, kind, gzip)?;
     let format = match kind {
         Kind::Sto => TrialFormat::Sto,
-        Kind::Csv => first_nonblank(&text).map_or(TrialFormat::QuatCsv, classify_csv_header),
+        Kind::Csv => first_header(&text).map_or(TrialFormat::QuatCsv, classify_csv_header),
     };
     let origin = origin_of(path);
     let mut trial = parse_trial(&text, &origin, &name_of(&origin), format, model)?;
@@ -328,7 +333,7 @@ pub fn read_trial_header(path: &Path, model: &Model) -> Result<TrialHeader, Tria
     let head = read_head(path, kind, gzip)?;
     let format = match kind {
         Kind::Sto => TrialFormat::Sto,
-        Kind::Csv => first_nonblank(&head).map_or(TrialFormat::QuatCsv, classify_csv_header),
+        Kind::Csv => first_header(&head).map_or(TrialFormat::QuatCsv, classify_csv_header),
     };
     let origin = origin_of(path);
     let layout = parse_header(&mut LineIter::new(&head), &origin, format, model)?;

@@ -77,6 +77,10 @@ pub struct Trial {
 }
 
 /// The file formats a trial can be read from and written to.
+/// Every input the trial readers accept, in one phrase (for errors; the help
+/// texts say the same).
+pub const ACCEPTED_INPUTS: &str = "a canonical CSV (time,<imu>_qw,_qx,_qy,_qz,...), an Euler CSV (time,<imu>_roll,_pitch,_yaw,...) or an OpenSim .sto, each optionally .gz; an Xsens MT Manager export (.txt or .csv, tab, comma or semicolon separated; one IMU); a folder of such exports; or an OpenSense mapping .xml";
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum TrialFormat {
@@ -159,9 +163,9 @@ impl Trial {
         median_dt(&self.time_s)
     }
 
-    /// Trial length, seconds: `T = n * dt` with dt the median sample interval
-    /// (METHOD.md section 4), or with gaps the span of the times plus one
-    /// interval ([`timing::trial_length_s`]).
+    /// Trial length, seconds: the span of the times times `n / (n - 1)` (`n * dt`
+    /// for a regular stream; docs/method.md section 7), or with gaps the span plus
+    /// one median interval ([`timing::trial_length_s`]).
     pub fn duration_s(&self) -> f64 {
         timing::trial_length_s(&self.time_s)
     }

@@ -1,7 +1,7 @@
 //! Sample times as they really come: irregular intervals and gaps.
 //!
-//! Times are seconds. The nominal interval is the median one (METHOD.md
-//! section 4); an interval longer than [`GAP_FACTOR`] times it is a gap: data
+//! Times are seconds. The nominal interval is the median one (docs/method.md
+//! section 7); an interval longer than [`GAP_FACTOR`] times it is a gap: data
 //! are missing there (dropped packets, a paused stream), and the report says so.
 
 use serde::{Deserialize, Serialize};
@@ -115,8 +115,8 @@ pub struct Timing {
     pub length_s: f64,
 }
 
-/// The trial length `T` windows are laid out on, seconds. METHOD.md section 4
-/// says `n * dt` with dt the median interval, which is exact for a regular
+/// The trial length `T` windows are laid out on, seconds. The source's rule
+/// is `n * dt` with dt the median interval, which is exact for a regular
 /// stream; it is computed here as the span of the times times `n / (n - 1)`
 /// (the same for a regular stream, up to rounding), which stays right for a
 /// jittery stream, where n times a median of jittered intervals can be off by

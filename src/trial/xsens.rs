@@ -1,4 +1,4 @@
-//! Xsens MT Manager text exports: one tab-separated file per sensor.
+//! Xsens MT Manager text exports: one file per sensor.
 //!
 //! ```text
 //! // Update Rate: 100.0Hz
@@ -7,11 +7,21 @@
 //! 00472<TAB>...
 //! ```
 //!
-//! Lines starting `//` are comments (`// Update Rate: <Hz>` gives the rate); the
-//! first other line is the header. The orientation `G_R_sensor` (sensor frame to
-//! the Xsens global frame, Z up) comes from, in this order of preference:
+//! Lines starting `//` are comments (`// Update Rate: <Hz>` gives the rate,
+//! `// Coordinate system: ENU|NED|NWU` the global frame); the first other line
+//! is the header. Fields are separated by tabs, commas or semicolons, whichever
+//! the header uses most (MT Manager's "export as" choices); with semicolons a
+//! decimal comma is accepted (`0,125`). Cells may be quoted. Columns may stand
+//! in any order and others (`SampleTimeFine`, `UTC_*`, `Acc_X`, ...) are
+//! ignored. Names are matched without regard to case, spaces, `_` or `-`, so
+//! MT Manager's older and newer spellings read alike (`PacketCounter`,
+//! `Packet Counter`, `Counter`; `Quat_q0`, `q0`, `Quat_W`; `Gyr_X`, `Gyro_X`).
 //!
-//! * `Quat_q0 Quat_q1 Quat_q2 Quat_q3` (scalar first);
+//! The orientation `G_R_sensor` (sensor frame to the Xsens global frame, Z up)
+//! comes from, in this order of preference:
+//!
+//! * `Quat_q0 Quat_q1 Quat_q2 Quat_q3` (scalar first; also `q0..q3`,
+//!   `Quat_W Quat_X Quat_Y Quat_Z`);
 //! * `Mat[i][j]`, i = row, j = column, 1-based, the nine entries in any order
 //!   (MT Manager lists them column by column: `Mat[1][1] Mat[2][1] Mat[3][1] Mat[1][2] ...`);
 //! * `Roll Pitch Yaw` (or `Euler_X Euler_Y Euler_Z`), degrees, `Rz(yaw) Ry(pitch) Rx(roll)`.
@@ -21,7 +31,8 @@
 //! three or none.
 //!
 //! `PacketCounter` is a 16-bit counter that wraps from 65535 to 0; it is unwrapped
-//! here and is what sensors are aligned on ([`super::xsens_trial`]).
+//! here and is what sensors are aligned on ([`super::xsens_trial`]). Without an
+//! `Update Rate` comment the rate comes from `SampleTimeFine` (ticks of 100 us).
 
 use super::io::parse::{show, LineIter, NORM_NOTE, NORM_TOLERANCE};
 use super::TrialError;
@@ -30,6 +41,9 @@ use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
 
 /// The packet counter's modulus (it is 16 bits wide).
 pub const COUNTER_MODULUS: u64 = 1 << 16;
+
+/// `SampleTimeFine` ticks per second (it counts 100 us steps).
+pub const SAMPLE_TIME_FINE_HZ: f64 = 10_000.0;
 
 /// Largest deviation of `R^T R` from the identity (any entry) accepted for a
 /// `Mat[i][j]` rotation matrix; six printed decimals stay within 1e-5.
@@ -46,6 +60,50 @@ pub enum OrientationColumns {
     Euler,
 }
 
+/// The field separator of an export, found from its header line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Delimiter {
+    Tab,
+    Comma,
+    Semicolon,
+}
+
+impl Delimiter {
+    /// The separator character.
+    pub fn char(self) -> char {
+        match self {
+            Delimiter::Tab => '\t',
+            Delimiter::Comma => ',',
+            Delimiter::Semicolon => ';',
+        }
+    }
+
+    /// `tab`, `comma` or `semicolon` (for messages).
+    pub fn name(self) -> &'static str {
+        match self {
+            Delimiter::Tab => "tab",
+            Delimiter::Comma => "comma",
+            Delimiter::Semicolon => "semicolon",
+        }
+    }
+
+    /// The separator the header line uses most (tab, then semicolon, then
+    /// comma among equals: a semicolon file may hold decimal commas).
+    pub fn of_header(header: &str) -> Delimiter {
+        let count = |c: char| header.matches(c).count();
+        let (tab, semi, comma) = (count('\t'), count(';'), count(','));
+        if tab >= semi && tab >= comma && tab > 0 {
+            Delimiter::Tab
+        } else if semi >= comma && semi > 0 {
+            Delimiter::Semicolon
+        } else if comma > 0 {
+            Delimiter::Comma
+        } else {
+            Delimiter::Tab
+        }
+    }
+}
+
 /// One sensor's export, read.
 #[derive(Debug, Clone)]
 pub struct XsensExport {
@@ -53,6 +111,13 @@ pub struct XsensExport {
     pub origin: String,
     /// The rate of `// Update Rate: <Hz>`, when the file has that comment.
     pub rate_hz: Option<f64>,
+    /// The rate implied by `SampleTimeFine` (median ticks per packet), when the
+    /// file has that column filled in.
+    pub sample_time_rate_hz: Option<f64>,
+    /// `// Coordinate system: ...` (ENU, NED, NWU), when given.
+    pub coordinate_system: Option<String>,
+    /// The field separator found.
+    pub delimiter: Delimiter,
     /// Unwrapped packet counter per sample (strictly increasing).
     pub counters: Vec<u64>,
     /// Line of each sample (1-based).
@@ -76,88 +141,120 @@ struct Columns {
     fields: Vec<usize>,
     /// `Gyr_X Gyr_Y Gyr_Z`, when present.
     gyro: Option<[usize; 3]>,
+    /// `SampleTimeFine`, when present.
+    sample_time: Option<usize>,
 }
 
-/// The gyroscope columns: all of `Gyr_X Gyr_Y Gyr_Z`, none, or an error at
+/// Accepted spellings of the packet counter column.
+const COUNTER_NAMES: [&str; 3] = ["PacketCounter", "Counter", "PacketCount"];
+/// Accepted spellings of the quaternion columns, scalar first.
+const QUAT_NAMES: [[&str; 4]; 3] = [
+    ["Quat_q0", "Quat_q1", "Quat_q2", "Quat_q3"],
+    ["q0", "q1", "q2", "q3"],
+    ["Quat_W", "Quat_X", "Quat_Y", "Quat_Z"],
+];
+/// Accepted spellings of the Euler columns (roll, pitch, yaw; degrees).
+const EULER_NAMES: [[&str; 3]; 2] = [["Roll", "Pitch", "Yaw"], ["Euler_X", "Euler_Y", "Euler_Z"]];
+/// Accepted spellings of the gyroscope columns (rad/s, sensor frame).
+const GYRO_NAMES: [[&str; 3]; 2] = [["Gyr_X", "Gyr_Y", "Gyr_Z"], ["Gyro_X", "Gyro_Y", "Gyro_Z"]];
+
+/// A header name reduced for matching: unquoted, lower case, without spaces, `_` and `-`.
+fn key(name: &str) -> String {
+    name.trim()
+        .trim_matches('"')
+        .chars()
+        .filter(|c| !matches!(c, ' ' | '_' | '-'))
+        .flat_map(char::to_lowercase)
+        .collect()
+}
+
+fn find(keys: &[String], name: &str) -> Option<usize> {
+    let k = key(name);
+    keys.iter().position(|h| *h == k)
+}
+
+fn find_all(keys: &[String], names: &[&str]) -> Option<Vec<usize>> {
+    names.iter().map(|n| find(keys, n)).collect()
+}
+
+/// The gyroscope columns: all three of one spelling, none, or an error at
 /// the first one present when some are missing.
 fn gyro_columns(
-    header: &[&str],
+    keys: &[String],
     origin: &str,
     line: u64,
 ) -> Result<Option<[usize; 3]>, TrialError> {
-    const NAMES: [&str; 3] = ["Gyr_X", "Gyr_Y", "Gyr_Z"];
-    let found = NAMES.map(|n| find(header, n));
-    match found {
-        [Some(x), Some(y), Some(z)] => Ok(Some([x, y, z])),
-        [None, None, None] => Ok(None),
-        _ => {
-            let first = found.iter().flatten().min().copied().unwrap_or(0);
-            let missing: Vec<&str> = NAMES
-                .iter()
-                .zip(found)
-                .filter(|(_, f)| f.is_none())
-                .map(|(n, _)| *n)
-                .collect();
-            Err(TrialError::at(
-                origin,
-                line,
-                first + 1,
-                format!(
-                    "incomplete gyroscope columns: missing {}; expected all of Gyr_X, Gyr_Y, Gyr_Z (rad/s, sensor frame) or none",
-                    missing.join(" and ")
-                ),
-            ))
+    for names in GYRO_NAMES {
+        let found = names.map(|n| find(keys, n));
+        match found {
+            [Some(x), Some(y), Some(z)] => return Ok(Some([x, y, z])),
+            [None, None, None] => continue,
+            _ => {
+                let first = found.iter().flatten().min().copied().unwrap_or(0);
+                let missing: Vec<&str> = names
+                    .iter()
+                    .zip(found)
+                    .filter(|(_, f)| f.is_none())
+                    .map(|(n, _)| *n)
+                    .collect();
+                return Err(TrialError::at(
+                    origin,
+                    line,
+                    first + 1,
+                    format!(
+                        "incomplete gyroscope columns: missing {}; expected all of {} (rad/s, sensor frame) or none",
+                        missing.join(" and "),
+                        names.join(", ")
+                    ),
+                ));
+            }
         }
     }
-}
-
-fn find(header: &[&str], name: &str) -> Option<usize> {
-    header.iter().position(|h| h.eq_ignore_ascii_case(name))
-}
-
-fn find_all(header: &[&str], names: &[String]) -> Option<Vec<usize>> {
-    names.iter().map(|n| find(header, n)).collect()
+    Ok(None)
 }
 
 fn columns(header: &[&str], origin: &str, line: u64) -> Result<Columns, TrialError> {
-    let counter = find(header, "PacketCounter").ok_or_else(|| {
-        TrialError::at(
-            origin,
-            line,
-            1,
-            "expected a 'PacketCounter' column (sensors are aligned on it); export it from MT Manager",
-        )
-    })?;
-    let gyro = gyro_columns(header, origin, line)?;
-    let quat: Vec<String> = (0..4).map(|k| format!("Quat_q{k}")).collect();
-    if let Some(fields) = find_all(header, &quat) {
-        return Ok(Columns {
-            counter,
-            kind: OrientationColumns::Quaternion,
-            fields,
-            gyro,
-        });
+    let keys: Vec<String> = header.iter().map(|h| key(h)).collect();
+    let counter = COUNTER_NAMES
+        .iter()
+        .find_map(|n| find(&keys, n))
+        .ok_or_else(|| {
+            TrialError::at(
+                origin,
+                line,
+                1,
+                format!(
+                    "expected a 'PacketCounter' column (sensors are aligned on it; also read as 'Counter'), found {} {}: {}; export it from MT Manager",
+                    header.len(),
+                    if header.len() == 1 { "column" } else { "columns" },
+                    show(&header.join(" | "))
+                ),
+            )
+        })?;
+    let gyro = gyro_columns(&keys, origin, line)?;
+    let sample_time = find(&keys, "SampleTimeFine");
+    let with = |kind, fields| Columns {
+        counter,
+        kind,
+        fields,
+        gyro,
+        sample_time,
+    };
+    for names in QUAT_NAMES {
+        if let Some(fields) = find_all(&keys, &names) {
+            return Ok(with(OrientationColumns::Quaternion, fields));
+        }
     }
     let mat: Vec<String> = (1..=3)
         .flat_map(|i| (1..=3).map(move |j| format!("Mat[{i}][{j}]")))
         .collect();
-    if let Some(fields) = find_all(header, &mat) {
-        return Ok(Columns {
-            counter,
-            kind: OrientationColumns::Matrix,
-            fields,
-            gyro,
-        });
+    let mat: Vec<&str> = mat.iter().map(String::as_str).collect();
+    if let Some(fields) = find_all(&keys, &mat) {
+        return Ok(with(OrientationColumns::Matrix, fields));
     }
-    for names in [["Roll", "Pitch", "Yaw"], ["Euler_X", "Euler_Y", "Euler_Z"]] {
-        let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
-        if let Some(fields) = find_all(header, &names) {
-            return Ok(Columns {
-                counter,
-                kind: OrientationColumns::Euler,
-                fields,
-                gyro,
-            });
+    for names in EULER_NAMES {
+        if let Some(fields) = find_all(&keys, &names) {
+            return Ok(with(OrientationColumns::Euler, fields));
         }
     }
     Err(TrialError::at(
@@ -170,63 +267,116 @@ fn columns(header: &[&str], origin: &str, line: u64) -> Result<Columns, TrialErr
 
 /// `100.0Hz` of a `// Update Rate: 100.0Hz` comment.
 fn rate_of_comment(comment: &str) -> Option<f64> {
-    let (key, value) = comment.split_once(':')?;
-    if !key.trim().eq_ignore_ascii_case("update rate") {
+    let value = comment_value(comment, "update rate")?;
+    let v = value
+        .strip_suffix("Hz")
+        .or_else(|| value.strip_suffix("hz"))
+        .unwrap_or(value);
+    v.trim()
+        .replace(',', ".")
+        .parse::<f64>()
+        .ok()
+        .filter(|r| r.is_finite() && *r > 0.0)
+}
+
+/// The value of a `// Key: value` comment when its key is `key` (any case).
+fn comment_value<'a>(comment: &'a str, key: &str) -> Option<&'a str> {
+    let (k, value) = comment.split_once(':')?;
+    k.trim().eq_ignore_ascii_case(key).then(|| value.trim())
+}
+
+/// The rate implied by `SampleTimeFine` readings: ticks per second over the
+/// median ticks per packet (readings that are missing or step backwards are
+/// left out). `None` without two usable readings.
+fn rate_of_sample_time(counters: &[u64], ticks: &[Option<f64>]) -> Option<f64> {
+    let mut per_packet: Vec<f64> = counters
+        .windows(2)
+        .zip(ticks.windows(2))
+        .filter_map(|(c, t)| {
+            let (a, b) = (t[0]?, t[1]?);
+            (b > a).then(|| (b - a) / (c[1] - c[0]) as f64)
+        })
+        .collect();
+    if per_packet.is_empty() {
         return None;
     }
-    let v = value.trim();
-    let v = v
-        .strip_suffix("Hz")
-        .or_else(|| v.strip_suffix("hz"))
-        .unwrap_or(v);
-    // Any number: the trial's assembly checks it is a usable rate.
-    v.trim().parse::<f64>().ok()
+    let mid = per_packet.len() / 2;
+    let (_, m, _) = per_packet.select_nth_unstable_by(mid, f64::total_cmp);
+    let hz = SAMPLE_TIME_FINE_HZ / *m;
+    hz.is_finite().then_some(hz)
 }
 
-fn cell<'a>(
-    cells: &[&'a str],
-    k: usize,
-    origin: &str,
-    line: u64,
-    what: &str,
-) -> Result<&'a str, TrialError> {
-    match cells.get(k) {
-        Some(c) if !c.trim().is_empty() => Ok(c.trim()),
-        Some(_) => Err(TrialError::at(
-            origin,
-            line,
-            k + 1,
-            format!("expected a number for {what}, found an empty cell"),
-        )),
-        None => Err(TrialError::at(
-            origin,
-            line,
-            cells.len() + 1,
-            format!(
-                "too few fields: expected {what} in tab-separated field {}, found {} fields",
+/// How one export's cells are read: where, and with which separator.
+struct Cells<'a> {
+    origin: &'a str,
+    delimiter: Delimiter,
+}
+
+impl Cells<'_> {
+    fn cell<'c>(
+        &self,
+        cells: &[&'c str],
+        k: usize,
+        line: u64,
+        what: &str,
+    ) -> Result<&'c str, TrialError> {
+        match cells.get(k).map(|c| c.trim().trim_matches('"').trim()) {
+            Some(c) if !c.is_empty() => Ok(c),
+            Some(_) => Err(TrialError::at(
+                self.origin,
+                line,
                 k + 1,
-                cells.len()
-            ),
-        )),
+                format!("expected a number for {what}, found an empty cell"),
+            )),
+            None => Err(TrialError::at(
+                self.origin,
+                line,
+                cells.len() + 1,
+                format!(
+                    "too few fields: expected {what} in {}-separated field {}, found {} fields",
+                    self.delimiter.name(),
+                    k + 1,
+                    cells.len()
+                ),
+            )),
+        }
     }
-}
 
-fn number(
-    cells: &[&str],
-    k: usize,
-    origin: &str,
-    line: u64,
-    what: &str,
-) -> Result<f64, TrialError> {
-    let c = cell(cells, k, origin, line, what)?;
-    match c.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(TrialError::at(
-            origin,
-            line,
-            k + 1,
-            format!("expected a finite number for {what}, found {}", show(c)),
-        )),
+    /// A number; with semicolons a decimal comma is read as a point.
+    fn parse(&self, c: &str) -> Option<f64> {
+        let v = match c.parse::<f64>() {
+            Ok(v) => v,
+            Err(_) if self.delimiter == Delimiter::Semicolon && c.contains(',') => {
+                c.replace(',', ".").parse::<f64>().ok()?
+            }
+            Err(_) => return None,
+        };
+        v.is_finite().then_some(v)
+    }
+
+    fn number(&self, cells: &[&str], k: usize, line: u64, what: &str) -> Result<f64, TrialError> {
+        let c = self.cell(cells, k, line, what)?;
+        self.parse(c).ok_or_else(|| {
+            TrialError::at(
+                self.origin,
+                line,
+                k + 1,
+                format!("expected a finite number for {what}, found {}", show(c)),
+            )
+        })
+    }
+
+    fn counter(&self, cells: &[&str], k: usize, line: u64) -> Result<u64, TrialError> {
+        let c = self.cell(cells, k, line, "PacketCounter")?;
+        match c.parse::<u64>() {
+            Ok(v) if v < COUNTER_MODULUS => Ok(v),
+            _ => Err(TrialError::at(
+                self.origin,
+                line,
+                k + 1,
+                format!("expected a packet counter 0..65535, found {}", show(c)),
+            )),
+        }
     }
 }
 
@@ -234,25 +384,37 @@ fn number(
 pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError> {
     let mut lines = LineIter::new(text);
     let mut rate_hz = None;
+    let mut coordinate_system = None;
     let (header_line, header_text) = loop {
         let Some((n, l)) = lines.next_nonblank() else {
             return Err(TrialError::at(
                 origin,
                 lines.line_no().max(1),
                 1,
-                "no header: expected '// ...' comment lines then a tab-separated header with PacketCounter",
+                "no header: expected '// ...' comment lines then a header with PacketCounter",
             ));
         };
         match l.trim_start().strip_prefix("//") {
-            Some(c) => rate_hz = rate_hz.or_else(|| rate_of_comment(c)),
+            Some(c) => {
+                rate_hz = rate_hz.or_else(|| rate_of_comment(c));
+                coordinate_system = coordinate_system.or_else(|| {
+                    comment_value(c, "coordinate system").map(|v| v.to_ascii_uppercase())
+                });
+            }
             None => break (n, l),
         }
     };
-    let header: Vec<&str> = header_text.split('\t').map(str::trim).collect();
+    let delimiter = Delimiter::of_header(header_text);
+    let sep = delimiter.char();
+    let header: Vec<&str> = header_text.split(sep).map(str::trim).collect();
     let cols = columns(&header, origin, header_line)?;
+    let reader = Cells { origin, delimiter };
     let mut out = XsensExport {
         origin: origin.to_string(),
         rate_hz,
+        sample_time_rate_hz: None,
+        coordinate_system,
+        delimiter,
         counters: Vec::new(),
         lines: Vec::new(),
         orientation: Vec::new(),
@@ -260,14 +422,17 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
         gyro: cols.gyro.map(|_| Vec::new()),
         renormalised: 0,
     };
+    let mut ticks: Vec<Option<f64>> = Vec::new();
     let mut last_raw: Option<(u64, u64)> = None;
     let mut wraps = 0u64;
+    let mut cells: Vec<&str> = Vec::with_capacity(header.len());
     for (line, text) in lines.by_ref() {
         if text.trim().is_empty() || text.trim_start().starts_with("//") {
             continue;
         }
-        let cells: Vec<&str> = text.split('\t').collect();
-        let raw = counter_cell(&cells, cols.counter, origin, line)?;
+        cells.clear();
+        cells.extend(text.split(sep));
+        let raw = reader.counter(&cells, cols.counter, line)?;
         if let Some((prev, prev_line)) = last_raw {
             if raw == prev {
                 return Err(TrialError::at(
@@ -291,10 +456,17 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
             }
         }
         last_raw = Some((raw, line));
-        let q = orientation(&cells, &cols, &header, origin, line, &mut out.renormalised)?;
+        let q = orientation(&reader, &cells, &cols, &header, line, &mut out.renormalised)?;
         if let (Some(fields), Some(g)) = (cols.gyro, &mut out.gyro) {
-            let [x, y, z] = fields.map(|k| number(&cells, k, origin, line, header[k]));
+            let [x, y, z] = fields.map(|k| reader.number(&cells, k, line, header[k]));
             g.push(Vector3::new(x?, y?, z?));
+        }
+        if let Some(k) = cols.sample_time {
+            ticks.push(
+                cells
+                    .get(k)
+                    .and_then(|c| reader.parse(c.trim().trim_matches('"'))),
+            );
         }
         out.counters.push(raw + wraps * COUNTER_MODULUS);
         out.lines.push(line);
@@ -308,33 +480,24 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
             format!("no samples: expected data rows after the header on line {header_line}"),
         ));
     }
+    if cols.sample_time.is_some() {
+        out.sample_time_rate_hz = rate_of_sample_time(&out.counters, &ticks);
+    }
     Ok(out)
 }
 
-fn counter_cell(cells: &[&str], k: usize, origin: &str, line: u64) -> Result<u64, TrialError> {
-    let c = cell(cells, k, origin, line, "PacketCounter")?;
-    match c.parse::<u64>() {
-        Ok(v) if v < COUNTER_MODULUS => Ok(v),
-        _ => Err(TrialError::at(
-            origin,
-            line,
-            k + 1,
-            format!("expected a packet counter 0..65535, found {}", show(c)),
-        )),
-    }
-}
-
 fn orientation(
+    reader: &Cells,
     cells: &[&str],
     cols: &Columns,
     header: &[&str],
-    origin: &str,
     line: u64,
     renormalised: &mut usize,
 ) -> Result<Quat, TrialError> {
+    let origin = reader.origin;
     let mut v = [0.0f64; 9];
     for (slot, &k) in v.iter_mut().zip(&cols.fields) {
-        *slot = number(cells, k, origin, line, header[k])?;
+        *slot = reader.number(cells, k, line, header[k])?;
     }
     let first = cols.fields[0] + 1;
     match cols.kind {
@@ -390,6 +553,38 @@ mod tests {
         assert_eq!(rate_of_comment(" Update Rate: 100.0Hz"), Some(100.0));
         assert_eq!(rate_of_comment(" Update Rate: 60 Hz"), Some(60.0));
         assert_eq!(rate_of_comment(" Filter Profile: human (46.1)"), None);
+    }
+
+    #[test]
+    fn delimiter_and_spellings() {
+        assert_eq!(
+            Delimiter::of_header("PacketCounter\tQuat_q0"),
+            Delimiter::Tab
+        );
+        assert_eq!(
+            Delimiter::of_header("PacketCounter,Quat_q0,Quat_q1"),
+            Delimiter::Comma
+        );
+        assert_eq!(
+            Delimiter::of_header("PacketCounter;Quat_q0"),
+            Delimiter::Semicolon
+        );
+        assert_eq!(key("\"Packet Counter\""), key("PacketCounter"));
+        assert_eq!(key("Quat_Q0"), key("quatq0"));
+        // Semicolons with decimal commas, quoted cells, newer spellings.
+        let text = "//  Update Rate: 50,0Hz\n\"Packet Counter\";\"Quat_W\";\"Quat_X\";\"Quat_Y\";\"Quat_Z\"\n1;\"0,6\";0,8;0;0\n";
+        let e = parse_export(text, "a.txt").unwrap();
+        assert_eq!((e.rate_hz, e.delimiter), (Some(50.0), Delimiter::Semicolon));
+        assert!(
+            (e.orientation[0].w - 0.6).abs() < 1e-15 && (e.orientation[0].i - 0.8).abs() < 1e-15
+        );
+        let e = parse_export(
+            "// Coordinate system: NED\nCounter,q0,q1,q2,q3\n7,1,0,0,0\n",
+            "b.txt",
+        )
+        .unwrap();
+        assert_eq!(e.coordinate_system.as_deref(), Some("NED"));
+        assert_eq!(e.counters, [7]);
     }
 
     #[test]

@@ -53,17 +53,36 @@ fn head(path: &Path, limit: u64) -> Option<String> {
     Some(String::from_utf8_lossy(&buf).into_owned())
 }
 
-/// True when `path` is a `.txt` file that starts like an MT Manager export
-/// (a `//` comment or a header with `PacketCounter`).
+/// True when `path` is a `.txt` or `.csv` file that starts like an MT Manager
+/// export (a `//` comment, or a header with a packet counter column).
 pub fn is_export_file(path: &Path) -> bool {
-    let txt = path
+    let ext = path
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("txt"));
-    txt && path.is_file()
-        && head(path, 4096).is_some_and(|t| {
-            let first = t.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
-            first.starts_with("//") || first.contains("PacketCounter")
-        })
+        .is_some_and(|e| e.eq_ignore_ascii_case("txt") || e.eq_ignore_ascii_case("csv"));
+    ext && path.is_file() && head(path, 4096).is_some_and(|t| starts_like_export(&t))
+}
+
+/// The text's first non-blank line is a `//` comment or names a packet counter.
+fn starts_like_export(text: &str) -> bool {
+    let first = text
+        .trim_start_matches('\u{feff}')
+        .lines()
+        .find(|l| !l.trim().is_empty())
+        .unwrap_or("");
+    let lower = first.to_ascii_lowercase();
+    first.trim_start().starts_with("//")
+        || lower.contains("packetcounter")
+        || lower.contains("packet counter")
+}
+
+/// The serial an export's file name ends in (after its last `_`).
+fn serial_of(path: &Path) -> String {
+    let stem = path
+        .file_stem()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .into_owned();
+    stem.rsplit('_').next().unwrap_or(&stem).to_string()
 }
 
 fn sorted_entries(dir: &Path) -> Vec<PathBuf> {
@@ -88,13 +107,21 @@ fn export_folder(xml: &Path, mapping: &Mapping) -> Option<PathBuf> {
     } else {
         dir
     };
-    let first = format!(
-        "{}{}.txt",
-        mapping.trial_prefix, mapping.sensors[0].file_suffix
-    );
+    let first = format!("{}{}", mapping.trial_prefix, mapping.sensors[0].file_suffix);
     std::iter::once(dir.to_path_buf())
         .chain(sorted_entries(dir).into_iter().filter(|p| p.is_dir()))
-        .find(|d| d.join(&first).is_file())
+        .find(|d| export_in(d, &first).is_file())
+}
+
+/// The export `<stem>.txt` in `dir`, or `<stem>.csv` when only that exists.
+fn export_in(dir: &Path, stem: &str) -> PathBuf {
+    let txt = dir.join(format!("{stem}.txt"));
+    let csv = dir.join(format!("{stem}.csv"));
+    if !txt.is_file() && csv.is_file() {
+        csv
+    } else {
+        txt
+    }
 }
 
 /// True when `name` names a file in a folder, not a path out of it.
@@ -110,14 +137,14 @@ fn is_plain_file_name(name: &str) -> bool {
 /// `.txt`), so that a mapping never reads files outside its folders.
 fn check_export_names(xml: &Path, mapping: &Mapping) -> Result<(), TrialError> {
     for s in &mapping.sensors {
-        let file = format!("{}{}.txt", mapping.trial_prefix, s.file_suffix);
+        let file = format!("{}{}", mapping.trial_prefix, s.file_suffix);
         if !is_plain_file_name(&file) {
             return Err(TrialError::at(
                 xml.display().to_string(),
                 s.line,
                 1,
                 format!(
-                    "sensor '{}': export name {file:?} (trial_prefix + name + .txt) leaves the mapping's folder; expected a plain file name",
+                    "sensor '{}': export name {file:?} (trial_prefix + name) leaves the mapping's folder; expected a plain file name",
                     s.file_suffix
                 ),
             ));
@@ -135,7 +162,10 @@ fn files_of_mapping(
         .sensors
         .iter()
         .map(|s| {
-            let f = folder.join(format!("{}{}.txt", mapping.trial_prefix, s.file_suffix));
+            let f = export_in(
+                folder,
+                &format!("{}{}", mapping.trial_prefix, s.file_suffix),
+            );
             if f.is_file() {
                 Ok((f, s.name_in_model.clone()))
             } else {
@@ -195,18 +225,26 @@ fn mapping_for_folder(dir: &Path) -> Option<PathBuf> {
         if check_export_names(&xml, &m).is_err() {
             continue;
         }
-        let first = format!("{}{}.txt", m.trial_prefix, m.sensors[0].file_suffix);
-        if dir.join(first).is_file() {
+        let first = format!("{}{}", m.trial_prefix, m.sensors[0].file_suffix);
+        if export_in(dir, &first).is_file() {
             return Some(xml);
         }
     }
     None
 }
 
-/// Resolves an Xsens trial path: a mapping XML or a folder of exports.
+/// Resolves an Xsens trial path: a mapping XML, a folder of exports, or a
+/// single export (a trial of one IMU, named as a mapping beside it names it,
+/// else by its serial).
 pub fn resolve(path: &Path) -> Result<XsensSource, TrialError> {
     if !path.is_dir() {
-        return resolve_mapping(path);
+        let xml = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+        if xml || !path.is_file() {
+            return resolve_mapping(path);
+        }
+        return Ok(single_export(path));
     }
     if let Some(xml) = mapping_for_folder(path) {
         let mut source = resolve_mapping(&xml)?;
@@ -220,12 +258,7 @@ pub fn resolve(path: &Path) -> Result<XsensSource, TrialError> {
         .into_iter()
         .filter(|p| is_export_file(p))
         .map(|p| {
-            let stem = p
-                .file_stem()
-                .unwrap_or_default()
-                .to_string_lossy()
-                .into_owned();
-            let serial = stem.rsplit('_').next().unwrap_or(&stem).to_string();
+            let serial = serial_of(&p);
             (p, serial)
         })
         .collect();
@@ -239,6 +272,42 @@ pub fn resolve(path: &Path) -> Result<XsensSource, TrialError> {
         mapping: None,
         files,
     })
+}
+
+/// One export as a trial: its IMU named by a mapping in its folder (or the
+/// folder above) that lists it, else by its serial.
+fn single_export(path: &Path) -> XsensSource {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let file = path.file_name().map(|n| n.to_string_lossy().into_owned());
+    let named = [dir.to_path_buf(), dir.join("..")]
+        .into_iter()
+        .filter(|d| d.is_dir())
+        .flat_map(|d| sorted_entries(&d))
+        .filter(|p| is_mapping_file(p))
+        .find_map(|xml| {
+            let m = parse_mapping(&std::fs::read_to_string(&xml).ok()?, "").ok()?;
+            let s = m.sensors.iter().find(|s| {
+                let stem = format!("{}{}", m.trial_prefix, s.file_suffix);
+                [".txt", ".csv"]
+                    .map(|e| format!("{stem}{e}"))
+                    .iter()
+                    .any(|n| file.as_deref() == Some(n.as_str()))
+            })?;
+            Some((xml, s.name_in_model.clone(), m))
+        });
+    match named {
+        Some((xml, name, m)) => XsensSource {
+            mapping: Some((xml, m)),
+            files: vec![(path.to_path_buf(), name)],
+        },
+        None => XsensSource {
+            mapping: None,
+            files: vec![(path.to_path_buf(), serial_of(path))],
+        },
+    }
 }
 
 /// The IMU names of an Xsens trial, as found (before aliases), without reading the data.
@@ -265,6 +334,15 @@ pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
 /// IMU names mapped through `model`'s aliases. `Trial::name` is the path's last component.
 pub fn read_xsens_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
     let source = resolve(path)?;
+    let single = path.is_file() && source.files.len() == 1 && !is_mapping_file(path);
+    if !single
+        && source
+            .files
+            .iter()
+            .all(|(_, n)| model.canonical_imu(n).is_none())
+    {
+        return Err(no_imu_error(path, &source, model));
+    }
     let mut exports = Vec::with_capacity(source.files.len());
     for (f, name) in &source.files {
         let origin = f.display().to_string();
@@ -280,6 +358,77 @@ pub fn read_xsens_trial(path: &Path, model: &Model) -> Result<Trial, TrialError>
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string());
     assemble(&name, exports, rotation, model)
+}
+
+/// The error for a folder or mapping none of whose sensors is an IMU of
+/// `model`: the names found and, without a mapping, the mapping XML to write.
+fn no_imu_error(path: &Path, source: &XsensSource, model: &Model) -> TrialError {
+    let names: Vec<&str> = source.files.iter().map(|(_, n)| n.as_str()).collect();
+    let others: Vec<&str> = crate::model::BUILTIN_MODELS
+        .iter()
+        .filter_map(|(n, _)| {
+            let m = Model::builtin(n).ok()?;
+            (m.name != model.name && names.iter().any(|i| m.canonical_imu(i).is_some()))
+                .then_some(*n)
+        })
+        .collect();
+    let hint = if others.is_empty() {
+        String::new()
+    } else {
+        format!(" (model {} knows them: pass --model)", others.join(", "))
+    };
+    let imus = model.imus.join(", ");
+    let Some((xml, _)) = &source.mapping else {
+        let dir = if path.is_dir() {
+            path
+        } else {
+            path.parent().unwrap_or(Path::new("."))
+        };
+        return TrialError::file(
+            path.display().to_string(),
+            format!(
+                "no sensor maps to an IMU of model {}{hint}: found {} exports named by serial ({}) and no mapping XML beside them or in the folder above. Write {} (each name_in_model one of {imus}):\n{}",
+                model.name,
+                names.len(),
+                names.join(", "),
+                dir.join("myIMUMappings.xml").display(),
+                mapping_template(&source.files)
+            ),
+        );
+    };
+    TrialError::file(
+        xml.display().to_string(),
+        format!(
+            "no sensor maps to an IMU of model {}{hint}: the mapping's name_in_model values are {}; expected IMUs of the model ({imus}) or its aliases",
+            model.name,
+            names.join(", ")
+        ),
+    )
+}
+
+/// An OpenSense mapping XML for these exports, `name_in_model` left to fill in.
+fn mapping_template(files: &[(PathBuf, String)]) -> String {
+    let prefix = files
+        .first()
+        .and_then(|(f, serial)| {
+            let stem = f.file_stem()?.to_string_lossy().into_owned();
+            Some(
+                stem.strip_suffix(serial.as_str())?
+                    .trim_end_matches('_')
+                    .to_string(),
+            )
+        })
+        .unwrap_or_default();
+    let mut xml = format!(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n<OpenSimDocument Version=\"40000\">\n  <XsensDataReaderSettings>\n    <trial_prefix>{prefix}</trial_prefix>\n    <ExperimentalSensors>\n"
+    );
+    for (_, serial) in files {
+        xml.push_str(&format!(
+            "      <ExperimentalSensor name=\"_{serial}\">\n        <name_in_model>?</name_in_model>\n      </ExperimentalSensor>\n"
+        ));
+    }
+    xml.push_str("    </ExperimentalSensors>\n  </XsensDataReaderSettings>\n</OpenSimDocument>");
+    xml
 }
 
 /// Counters shifted by whole wraps so that every file starts within half a
@@ -319,13 +468,38 @@ fn common_rate(exports: &[(String, XsensExport)]) -> Result<f64, TrialError> {
             }
         }
     }
-    rate.map(|(r, _)| r).ok_or_else(|| {
-        TrialError::at(
-            &exports[0].1.origin,
-            1,
-            1,
-            "no update rate: expected a comment line '// Update Rate: <Hz>' in at least one export",
-        )
+    if let Some((r, _)) = rate {
+        return Ok(r);
+    }
+    // No `Update Rate` comment anywhere: the first export's SampleTimeFine.
+    let found = exports
+        .iter()
+        .find_map(|(_, e)| Some((e.sample_time_rate_hz?, &e.origin)));
+    if let Some((r, origin)) = found {
+        check_rate(r, origin)?;
+    }
+    found
+        .map(|(r, _)| r)
+        .ok_or_else(|| {
+            TrialError::at(
+                &exports[0].1.origin,
+                1,
+                1,
+                "no update rate: expected a comment line '// Update Rate: <Hz>' or a filled-in SampleTimeFine column in at least one export",
+            )
+        })
+}
+
+/// A warning when an export says its global frame is not Z-up.
+fn frame_warning(exports: &[(String, XsensExport)]) -> Option<String> {
+    exports.iter().find_map(|(_, e)| {
+        let system = e.coordinate_system.as_deref()?;
+        (system == "NED").then(|| {
+            format!(
+                "{} says 'Coordinate system: NED' (Z down): pass --vertical z-down",
+                file_name(&e.origin)
+            )
+        })
     })
 }
 
@@ -379,7 +553,7 @@ pub(crate) fn assemble(
             format!("the sensors share no packet: their counters cover {start} and {end} apart; expected exports of one recording"),
         ));
     }
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = frame_warning(&exports).into_iter().collect();
     // Indices, per file, of the packets every file has.
     let mut pos = vec![0usize; exports.len()];
     let mut kept: Vec<(u64, Vec<usize>)> = Vec::new();

@@ -6,6 +6,7 @@
 use super::app::{App, Effect, LoadState, Loaded};
 use crate::limits::LimitTable;
 use crate::metrics::trial_figures;
+use crate::pose::convention::check_conventions;
 use crate::pose::{calibrate, PoseCalibration, PoseTime};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -54,7 +55,9 @@ pub fn calibrate_job(
     limits: &LimitTable,
 ) -> super::app::Msg {
     let result = calibrate(&loaded.trial, &loaded.model, calibration)
-        .map(|(trial, record)| {
+        .map(|(mut trial, record)| {
+            let checks = check_conventions(&trial, &loaded.model, limits, true);
+            trial.warnings.extend(checks);
             let before = trial_figures(&trial, None, loaded.truth.as_ref(), &loaded.model, limits);
             Arc::new(Loaded {
                 trial,
@@ -74,8 +77,13 @@ pub fn calibrated(app: &mut App, file: &str, result: Result<Arc<Loaded>, String>
     match result {
         Ok(l) => {
             if let Some(p) = &l.pose {
+                let checks = check_conventions(&l.trial, &l.model, &app.limits.table, true);
+                let note = match checks.first() {
+                    Some(w) => format!("; {} convention warning(s), first: {w}", checks.len()),
+                    None => String::new(),
+                };
                 app.info(format!(
-                    "pose calibration at {}: heading corrected by {:.1} deg; P undoes",
+                    "pose calibration at {}: heading corrected by {:.1} deg; P undoes{note}",
                     short(p.calibration.at),
                     p.heading_deg
                 ));

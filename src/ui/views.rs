@@ -1,4 +1,4 @@
-//! The analysis views of the open trial (issue 7): 3-D scatter projections
+//! The analysis views of the open trial: 3-D scatter projections
 //! ([`super::scatter`], key `x`), the globographic plot ([`super::globe`], `o`),
 //! the applied correction over time ([`super::applied`], `a`) and the stick
 //! figure ([`super::stick`], `f`), and the heading drift per IMU

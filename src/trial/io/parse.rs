@@ -40,6 +40,14 @@ impl<'a> LineIter<'a> {
     pub(crate) fn next_nonblank(&mut self) -> Option<(u64, &'a str)> {
         self.find(|(_, l)| !l.trim().is_empty())
     }
+
+    /// The next line that is neither blank nor a `#` comment (a CSV header).
+    pub(crate) fn next_header(&mut self) -> Option<(u64, &'a str)> {
+        self.find(|(_, l)| {
+            let t = l.trim();
+            !t.is_empty() && !t.starts_with('#')
+        })
+    }
 }
 
 impl<'a> Iterator for LineIter<'a> {
@@ -137,9 +145,10 @@ pub(crate) fn classify_csv_header(header: &str) -> TrialFormat {
     TrialFormat::QuatCsv
 }
 
-/// The first non-blank line of `text` (the CSV header), if any.
-pub(crate) fn first_nonblank(text: &str) -> Option<&str> {
-    LineIter::new(text).next_nonblank().map(|(_, l)| l)
+/// The first line of `text` that is neither blank nor a `#` comment (the CSV
+/// header), if any.
+pub(crate) fn first_header(text: &str) -> Option<&str> {
+    LineIter::new(text).next_header().map(|(_, l)| l)
 }
 
 fn empty_file(origin: &str, format: TrialFormat) -> TrialError {
@@ -242,7 +251,7 @@ pub(crate) fn parse_csv_header(
     model: &Model,
 ) -> Result<Layout, TrialError> {
     let (line, text) = lines
-        .next_nonblank()
+        .next_header()
         .ok_or_else(|| empty_file(origin, format))?;
     let suffixes: &[&str] = if format == TrialFormat::EulerCsv {
         &EULER_SUFFIXES

@@ -272,8 +272,13 @@ fn trial_file_names() {
     ] {
         assert!(!is_trial_file(Path::new(no)), "{no}");
     }
-    let e = detect_format(Path::new("x.txt")).unwrap_err();
-    assert!(e.message.contains("expected a name ending in .csv"), "{e}");
+    let e = detect_format(Path::new("x.dat")).unwrap_err();
+    assert!(e.message.contains("Xsens MT Manager export"), "{e}");
+    // A .txt names an Xsens export.
+    assert_eq!(
+        detect_format(Path::new("x.txt")).unwrap(),
+        (TrialFormat::Xsens, false)
+    );
 }
 
 #[test]
@@ -692,8 +697,11 @@ fn trial_bad_files() {
 
     let e = read_trial(&dir.path().join("absent.csv"), &m).unwrap_err();
     assert!(e.message.contains("cannot read"), "{e}");
-    let e = read_trial(&temp_file(&dir, "x.txt", HDR.as_bytes()), &m).unwrap_err();
+    let e = read_trial(&temp_file(&dir, "x.dat", HDR.as_bytes()), &m).unwrap_err();
     assert!(e.message.contains("unknown trial file type"), "{e}");
+    // A .txt is read as an Xsens export, and says what it lacks.
+    let e = read_trial(&temp_file(&dir, "x.txt", HDR.as_bytes()), &m).unwrap_err();
+    assert!(e.message.contains("'PacketCounter' column"), "{e}");
 }
 
 #[test]
