@@ -9,6 +9,7 @@ pub mod analysis;
 pub mod baselines;
 pub mod calibration;
 pub mod ik;
+pub mod input;
 pub mod limits;
 pub mod metrics;
 pub mod model;

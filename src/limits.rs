@@ -96,6 +96,7 @@ pub struct LimitsError {
 
 /// Settings of a correction that are not per joint.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Settings {
     /// Weight of the correction's rotation angle in the cost (per degree).
     pub lambda1: f64,
@@ -126,6 +127,7 @@ impl Default for Settings {
 
 /// `joint_limits/settings.toml`: the settings plus the name of the default table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SettingsFile {
     /// File name of the default limit table in the same folder.
     pub table: String,
@@ -160,9 +162,15 @@ impl SettingsFile {
                 message: e.message().to_string(),
             }
         })?;
-        s.settings().validate(origin)?;
+        let located = |mut e: LimitsError| {
+            let key = e.message.split_whitespace().next().unwrap_or("");
+            e.line = key_line(text, key);
+            e.column = 1;
+            e
+        };
+        s.settings().validate(origin).map_err(located)?;
         if !(s.glitch_deg.is_finite() && s.glitch_deg > 0.0 && s.glitch_deg <= 180.0) {
-            return Err(LimitsError {
+            return Err(located(LimitsError {
                 file: origin.into(),
                 line: 0,
                 column: 0,
@@ -170,7 +178,7 @@ impl SettingsFile {
                     "glitch_deg must be a number of degrees in (0, 180], found {}",
                     s.glitch_deg
                 ),
-            });
+            }));
         }
         Ok(s)
     }
@@ -211,13 +219,17 @@ impl LimitsDir {
     pub fn load(dir: &Path) -> Result<LimitsDir, LimitsError> {
         let settings_path = dir.join("settings.toml");
         let origin = settings_path.display().to_string();
+        // Finish a save of table and settings that a kill interrupted (a
+        // read-only folder has none to finish).
+        let _ = crate::save::recover(dir);
         let (settings, text) = if settings_path.exists() {
-            let text = std::fs::read_to_string(&settings_path).map_err(|e| LimitsError {
-                file: origin.clone(),
-                line: 0,
-                column: 0,
-                message: format!("cannot read: {e}"),
-            })?;
+            let text =
+                crate::input::read_text_located(&settings_path).map_err(|e| LimitsError {
+                    file: origin.clone(),
+                    line: e.line,
+                    column: e.column,
+                    message: format!("cannot read: {}", e.error),
+                })?;
             (SettingsFile::parse(&text, &origin)?, Some(text))
         } else {
             let builtin = SettingsFile::parse(BUILTIN_SETTINGS, "<built-in settings.toml>")?;
@@ -262,35 +274,47 @@ fn line_col(text: &str, offset: usize) -> (u64, usize) {
 }
 
 impl Settings {
-    /// Checks the values are usable: finite, lambda1 >= 0, 0 < hop <= window.
+    /// Checks the values are usable, wherever they came from (a settings
+    /// file, flags, a sidecar): finite, `0 <= lambda1 <= MAX_LAMBDA1`,
+    /// `0 < window_s <= MAX_SPAN_S` and `window_s / MAX_OVERLAP <= hop_s <= window_s`.
+    /// Whether the windows suit a given trial is [`crate::acm::window::check_layout`]'s.
     pub fn validate(&self, origin: &str) -> Result<(), LimitsError> {
+        use crate::trial::timing::MAX_SPAN_S;
         let err = |message: String| LimitsError {
             file: origin.into(),
             line: 0,
             column: 0,
             message,
         };
-        if !(self.lambda1.is_finite() && self.lambda1 >= 0.0) {
+        if !(self.lambda1.is_finite() && (0.0..=MAX_LAMBDA1).contains(&self.lambda1)) {
             return Err(err(format!(
-                "lambda1 must be a finite number >= 0, found {}",
+                "lambda1 must be a finite number in [0, {MAX_LAMBDA1}], found {}",
                 self.lambda1
             )));
         }
-        if !(self.window_s.is_finite() && self.window_s > 0.0) {
+        if !(self.window_s.is_finite() && self.window_s > 0.0 && self.window_s <= MAX_SPAN_S) {
             return Err(err(format!(
-                "window_s must be a positive number of seconds, found {}",
+                "window_s must be a positive number of seconds, at most {MAX_SPAN_S:e}, found {}",
                 self.window_s
             )));
         }
-        if !(self.hop_s.is_finite() && self.hop_s > 0.0 && self.hop_s <= self.window_s) {
+        let least = self.window_s / MAX_OVERLAP;
+        if !(self.hop_s.is_finite() && self.hop_s >= least && self.hop_s <= self.window_s) {
             return Err(err(format!(
-                "hop_s must be positive and at most window_s ({}), found {}",
+                "hop_s must be between window_s / {MAX_OVERLAP} ({least}) and window_s ({}), found {}",
                 self.window_s, self.hop_s
             )));
         }
         Ok(())
     }
 }
+
+/// Largest `lambda1` (per degree): beyond it the correction angle is all the
+/// cost sees and the limits nothing.
+pub const MAX_LAMBDA1: f64 = 1e6;
+
+/// Most windows that may overlap any instant (`window_s / hop_s`).
+pub const MAX_OVERLAP: f64 = 1000.0;
 
 /// Parses an axis name `X`, `Y` or `Z` (case-insensitive) into 0, 1, 2.
 pub fn parse_axis(s: &str) -> Option<usize> {
@@ -316,11 +340,11 @@ impl LimitTable {
     /// Reads and parses a limit table file.
     pub fn load(path: &Path) -> Result<LimitTable, LimitsError> {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| LimitsError {
+        let text = crate::input::read_text_located(path).map_err(|e| LimitsError {
             file: origin.clone(),
-            line: 0,
-            column: 0,
-            message: format!("cannot read: {e}"),
+            line: e.line,
+            column: e.column,
+            message: format!("cannot read: {}", e.error),
         })?;
         LimitTable::parse(&text, &origin)
     }
@@ -501,17 +525,12 @@ impl LimitTable {
         let mut out = HEADER.join(",");
         out.push('\n');
         for r in &self.rows {
-            let movement = if r.movement.contains([',', '"']) {
-                format!("\"{}\"", r.movement.replace('"', "\"\""))
-            } else {
-                r.movement.clone()
-            };
             let _ = writeln!(
                 out,
                 "{},{},{},{},{},{},{}",
-                r.joint,
+                csv_field(&r.joint),
                 axis_name(r.axis),
-                movement,
+                csv_field(&r.movement),
                 r.lower_deg,
                 r.upper_deg,
                 r.centroid_deg.map(|c| c.to_string()).unwrap_or_default(),
@@ -525,6 +544,16 @@ impl LimitTable {
     pub fn hash(&self) -> String {
         let digest = Sha256::digest(self.rows_csv().as_bytes());
         digest.iter().map(|b| format!("{b:02x}")).collect()
+    }
+}
+
+/// A text cell as CSV: quoted (quotes doubled) when it holds a separator, a
+/// quote or a line break, or starts with the comment sign, so that it reads back as is.
+fn csv_field(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains([',', '"', '\n', '\r']) || text.starts_with('#') {
+        format!("\"{}\"", text.replace('"', "\"\"")).into()
+    } else {
+        text.into()
     }
 }
 

@@ -234,6 +234,7 @@ impl From<Hinge> for String {
 
 /// One joint: the rotation of the distal IMU relative to the proximal one.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct Joint {
     /// Joint name, e.g. `l_knee`.
     pub name: String,
@@ -315,6 +316,7 @@ impl Joint {
 
 /// A body model: which IMUs exist, how they form joints, in which order to correct.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct Model {
     /// Short name, e.g. `infant13`.
     pub name: String,
@@ -398,10 +400,24 @@ pub enum ModelError {
         path: String,
         source: std::io::Error,
     },
-    #[error("{path}: {message}")]
-    Parse { path: String, message: String },
-    #[error("{path}: {message}")]
-    Invalid { path: String, message: String },
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse {
+        path: String,
+        /// 1-based line, 0 when the file as a whole is meant.
+        line: u64,
+        /// 1-based column (characters), 0 when the whole line is meant.
+        column: usize,
+        message: String,
+    },
+    #[error("{path}:{line}:{column}: {message}")]
+    Invalid {
+        path: String,
+        /// 1-based line of what the message names, 0 when it names nothing.
+        line: u64,
+        /// 1-based column, 0 when the whole line is meant.
+        column: usize,
+        message: String,
+    },
     #[error(
         "unknown built-in model '{0}' (known: infant13, opensim, opensense_lower, full_body16)"
     )]
@@ -430,24 +446,59 @@ impl Model {
             return Model::builtin(name_or_path);
         }
         let path = Path::new(name_or_path);
-        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
-            path: name_or_path.to_string(),
-            source,
+        let text = crate::input::read_text_located(path).map_err(|e| {
+            if e.line > 0 {
+                ModelError::Parse {
+                    path: name_or_path.to_string(),
+                    line: e.line,
+                    column: e.column,
+                    message: e.error.to_string(),
+                }
+            } else {
+                ModelError::Io {
+                    path: name_or_path.to_string(),
+                    source: e.error,
+                }
+            }
         })?;
         Model::from_toml(&text, name_or_path)
     }
 
     /// Parses and validates a model from TOML text; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Model, ModelError> {
-        let model: Model = toml::from_str(text).map_err(|e| ModelError::Parse {
-            path: origin.to_string(),
-            message: e.to_string(),
+        let model: Model = toml::from_str(text).map_err(|e| {
+            let (line, column) = e
+                .span()
+                .map(|sp| crate::calibration::error::line_col(text, sp.start))
+                .unwrap_or((0, 0));
+            ModelError::Parse {
+                path: origin.to_string(),
+                line,
+                column,
+                message: e.message().trim().to_string(),
+            }
         })?;
-        model.validate().map_err(|message| ModelError::Invalid {
-            path: origin.to_string(),
-            message,
+        model.validate().map_err(|message| {
+            let line = crate::input::line_naming(text, &message).unwrap_or(0);
+            ModelError::Invalid {
+                path: origin.to_string(),
+                line,
+                column: usize::from(line > 0),
+                message,
+            }
         })?;
         Ok(model)
+    }
+
+    /// Checks a model that did not come from a file (a sidecar's) as
+    /// [`Model::from_toml`] checks one that did; `origin` names it in errors.
+    pub fn check(&self, origin: &str) -> Result<(), ModelError> {
+        self.validate().map_err(|message| ModelError::Invalid {
+            path: origin.to_string(),
+            line: 0,
+            column: 0,
+            message,
+        })
     }
 
     fn validate(&self) -> Result<(), String> {
@@ -687,7 +738,12 @@ distal = "b"
         let e = Model::from_toml("name = 3", "m.toml")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("m.toml") && e.contains("line 1"), "{e}");
+        assert!(e.starts_with("m.toml:1:8: invalid type"), "{e}");
+        // A misspelt key is an error at its line, not silently ignored.
+        let e = Model::from_toml("name = \"m\"\nbasee = \"a\"\n", "m.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("m.toml:2:1: unknown field `basee`"), "{e}");
     }
 
     #[test]
@@ -736,7 +792,8 @@ distal = "b"
         let base = "name = \"x\"\nbase = \"a\"\nimus = [\"a\", \"b\"]\n[[joint]]\nname = \"j\"\nkind = \"knee\"\nproximal = \"a\"\ndistal = \"b\"\n";
         let cases = [
             ("dof = [\"y\", \"y\"]", "listed twice"),
-            ("dof = [\"w\"]", "line"),
+            ("dof = [\"w\"]", "m.toml:9:8: unknown variant"),
+            ("doff = [\"y\"]", "m.toml:9:1: unknown field `doff`"),
             (
                 "dof = [\"y\"]\nhard_limits_deg = { x = [0, 10] }",
                 "not in `dof`",

@@ -9,7 +9,7 @@ use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
 use crate::pose::PoseRecord;
-use crate::save::atomic_write;
+use crate::save::{atomic_write, OutputLock};
 use crate::trial::{write_trial, Trial, TrialFormat};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -51,6 +51,11 @@ pub struct Sidecar {
     pub version: String,
     pub input: InputRecord,
     pub output: String,
+    /// SHA-256 of the output file's bytes as written: a reader of the output
+    /// can tell whether this sidecar describes it (a save cut short between
+    /// the trial and its sidecar leaves them apart).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_sha256: Option<String>,
     pub output_format: TrialFormat,
     pub variant: Variant,
     pub settings: Settings,
@@ -115,6 +120,7 @@ impl Sidecar {
             version: env!("CARGO_PKG_VERSION").into(),
             input,
             output: output.display().to_string(),
+            output_sha256: None,
             output_format,
             variant: correction.variant,
             settings: correction.settings,
@@ -146,6 +152,25 @@ impl Sidecar {
         Ok(t)
     }
 
+    /// Checks what the sidecar would run with as if it came from files:
+    /// settings ([`Settings::validate`]), model ([`Model::check`]) and the
+    /// limit table (its hash, and rows for every joint kind of the model).
+    pub fn check(&self, origin: &str) -> anyhow::Result<()> {
+        self.settings.validate(&format!("{origin} (settings)"))?;
+        self.model.check(&format!("{origin} (model)"))?;
+        let table = self.table(origin)?;
+        table.check_covers(&self.model, &format!("{origin} (limits.csv)"))?;
+        Ok(())
+    }
+
+    /// `None` when `input` hashes to the recorded input SHA-256, else the hash found.
+    pub fn check_input(&self, input: &Path) -> anyhow::Result<Option<String>> {
+        let bytes = crate::trial::input_bytes(input)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", input.display()))?;
+        let found = sha256_hex(&bytes);
+        Ok((found != self.input.sha256).then_some(found))
+    }
+
     /// Pretty JSON text.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("sidecar serialises")
@@ -153,7 +178,7 @@ impl Sidecar {
 
     /// Reads a sidecar file.
     pub fn load(path: &Path) -> anyhow::Result<Sidecar> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::input::read_text(path)
             .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
         serde_json::from_str(&text).map_err(|e| {
             anyhow::anyhow!(
@@ -164,6 +189,27 @@ impl Sidecar {
             )
         })
     }
+}
+
+/// A warning when the sidecar beside the trial file `path` does not describe
+/// these bytes of it (the file was replaced after the sidecar was written, or
+/// a save was cut short between them); `None` when it does, or there is no
+/// sidecar or it records no output hash.
+pub fn mismatch_warning(path: &Path, bytes: &[u8]) -> Option<String> {
+    let sc_path = sidecar_path(path);
+    if !sc_path.is_file() {
+        return None;
+    }
+    let recorded = match Sidecar::load(&sc_path) {
+        Ok(s) => s.output_sha256?,
+        Err(e) => return Some(format!("sidecar beside it is unreadable: {e}")),
+    };
+    (sha256_hex(bytes) != recorded).then(|| {
+        format!(
+            "{} does not describe this file (output SHA-256 differs): the file changed after that correction was saved",
+            sc_path.display()
+        )
+    })
 }
 
 /// The default output path of a corrected trial:
@@ -260,12 +306,19 @@ impl SaveRequest<'_> {
 
     /// Writes the corrected trial and the given sidecar (built by
     /// [`SaveRequest::sidecar`], perhaps amended), as [`SaveRequest::save`] does.
-    pub fn save_with(&self, sidecar: Sidecar) -> anyhow::Result<PathBuf> {
+    /// The output and its sidecar are written under an [`OutputLock`]: a
+    /// second run writing the same output waits, then refuses.
+    pub fn save_with(&self, mut sidecar: Sidecar) -> anyhow::Result<PathBuf> {
         if let Some(dir) = self.output.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| anyhow::anyhow!("{}: cannot create folder: {e}", dir.display()))?;
         }
+        let _lock = OutputLock::acquire(self.output)
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", self.output.display()))?;
         write_trial(&self.correction.corrected, self.output, self.output_format)?;
+        let written = std::fs::read(self.output)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read back: {e}", self.output.display()))?;
+        sidecar.output_sha256 = Some(sha256_hex(&written));
         if let Some(run) = &self.correction.ik {
             write_coordinates(run, &coordinates_path(self.output))?;
         }

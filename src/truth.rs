@@ -64,9 +64,9 @@ impl TruthMeta {
     }
 
     /// Writes the JSON atomically to `path`.
-    pub fn save(&self, path: &Path) -> Result<(), TrialError> {
+    pub fn save(&self, path: &Path) -> Result<(), crate::save::WriteError> {
         crate::save::atomic_write(path, self.to_json().as_bytes())
-            .map_err(|e| TrialError::file(path.display().to_string(), format!("cannot write: {e}")))
+            .map_err(|e| crate::save::WriteError::io(path, &e))
     }
 }
 
@@ -136,7 +136,10 @@ impl Truth {
 
     /// Saves `NAME.truth.csv.gz` and `NAME.truth.json` beside `trial_path`;
     /// returns their paths.
-    pub fn save_beside(&self, trial_path: &Path) -> Result<(PathBuf, PathBuf), TrialError> {
+    pub fn save_beside(
+        &self,
+        trial_path: &Path,
+    ) -> Result<(PathBuf, PathBuf), crate::save::WriteError> {
         let (csv, json) = truth_paths(trial_path);
         trial::write_trial(&self.segments, &csv, TrialFormat::QuatCsv)?;
         self.meta.save(&json)?;
@@ -193,7 +196,7 @@ fn load(csv: &Path, json: &Path, model: &Model) -> Result<Truth, TrialError> {
             "missing: a truth needs its .truth.json file (the .truth.csv.gz is optional)",
         ));
     }
-    let text = std::fs::read_to_string(json)
+    let text = crate::input::read_text(json)
         .map_err(|e| TrialError::file(&json_name, format!("cannot read: {e}")))?;
     let meta = TruthMeta::from_json(&text, &json_name)?;
     if meta.model != model.name {

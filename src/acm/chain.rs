@@ -723,18 +723,34 @@ fn solve_windows(
         .iter()
         .map(|w| WindowCost::new(&measured[w.first..w.end], limits, lambda1))
         .collect();
-    // Pass 1: every window from identity, in parallel.
-    let first: Vec<Solution> = costs
+    // Pass 1: every window from identity, in parallel. Windows solved on the
+    // same samples (thin windows in a long gap all borrow one span) have one
+    // solution, found once.
+    let mut span_index = std::collections::HashMap::new();
+    let mut distinct: Vec<usize> = Vec::new();
+    let slot: Vec<usize> = windows
+        .iter()
+        .enumerate()
+        .map(|(k, w)| {
+            *span_index.entry((w.first, w.end)).or_insert_with(|| {
+                distinct.push(k);
+                distinct.len() - 1
+            })
+        })
+        .collect();
+    let solved: Vec<Solution> = distinct
         .par_iter()
-        .map(|cost| {
+        .map(|&k| {
             if control.cancelled() {
                 return Err(Cancelled);
             }
-            let s = solve_window(cost, &[Quat::identity()], solver);
+            let s = solve_window(&costs[k], &[Quat::identity()], solver);
             progress();
             Ok(s)
         })
         .collect::<Result<_, Cancelled>>()?;
+    (distinct.len()..windows.len()).for_each(|_| progress());
+    let first: Vec<Solution> = slot.iter().map(|&u| solved[u]).collect();
     // Pass 2: where a neighbour's solution is cheaper here, descend from it.
     let second: Vec<Solution> = (0..costs.len())
         .into_par_iter()

@@ -66,15 +66,17 @@ pub fn layout(time_s: &[f64], win_s: f64, hop_s: f64) -> Vec<Window> {
     let dt = median_dt(time_s);
     let total = trial_length_s(time_s);
     let index_of = |s: f64| time_s.partition_point(|&t| t - t0 < s - EPS);
-    if total <= win_s + EPS {
+    if !(total.is_finite() && win_s.is_finite() && win_s > 0.0) || total <= win_s + EPS {
         return whole_trial(time_s);
     }
-    let count = ((total - win_s) / hop_s - EPS).ceil() as usize + 1;
+    let hop_s = bounded_hop(total, win_s, hop_s);
+    let count = window_count(total, win_s, hop_s);
     let span = |a: f64, b: f64| {
         let first = index_of(a);
         let end = if b >= total - EPS { n } else { index_of(b) };
         (first, end)
     };
+    let enough = |(f, e): (usize, usize)| (e - f) as f64 * dt >= MIN_DATA_FRACTION * win_s;
     (0..count)
         .map(|k| {
             let start = (k as f64 * hop_s).min(total - win_s);
@@ -92,22 +94,105 @@ pub fn layout(time_s: &[f64], win_s: f64, hop_s: f64) -> Vec<Window> {
                 borrowed_s: None,
             };
             if data_s < MIN_DATA_FRACTION * win_s {
-                let (mut a, mut b) = (start, start + win_s);
-                loop {
-                    a = (a - hop_s).max(0.0);
-                    b = (b + hop_s).min(total);
-                    let (f, e) = span(a, b);
-                    (w.first, w.end) = (f, e);
-                    let whole = a <= 0.0 && b >= total - EPS;
-                    if (e - f) as f64 * dt >= MIN_DATA_FRACTION * win_s || whole {
-                        break;
-                    }
-                }
+                let [a, b] = borrow(start, win_s, hop_s, total, |a, b| enough(span(a, b)));
+                (w.first, w.end) = span(a, b);
                 w.borrowed_s = Some([a, b]);
             }
             w
         })
         .collect()
+}
+
+/// Most windows a trial is laid out in; a hop that would make more is widened.
+pub const MAX_WINDOWS: usize = 100_000;
+
+/// A window shorter than this many median sample intervals holds too few
+/// samples to estimate a correction from.
+pub const MIN_WINDOW_SAMPLES: f64 = 4.0;
+
+/// Number of windows of length `win_s` and hop `hop_s` on a trial of `total` s.
+fn window_count(total: f64, win_s: f64, hop_s: f64) -> usize {
+    ((total - win_s) / hop_s - EPS).ceil().max(0.0) as usize + 1
+}
+
+/// `hop_s`, or the shortest hop that keeps the layout within [`MAX_WINDOWS`]
+/// when it is not a positive number or would exceed them (callers check
+/// settings with [`check_layout`] first; this only keeps the layout bounded).
+fn bounded_hop(total: f64, win_s: f64, hop_s: f64) -> f64 {
+    let hop = if hop_s.is_finite() && hop_s > 0.0 {
+        hop_s
+    } else {
+        win_s
+    };
+    if window_count(total, win_s, hop) <= MAX_WINDOWS {
+        hop
+    } else {
+        (total - win_s) / (MAX_WINDOWS - 1) as f64 * (1.0 + 1e-9)
+    }
+}
+
+/// Why windows of `win_s` and hop `hop_s` seconds do not suit the trial with
+/// these sample times, if they do not: a window must hold at least
+/// [`MIN_WINDOW_SAMPLES`] median intervals, and the trial must need no more
+/// than [`MAX_WINDOWS`] windows.
+pub fn check_layout(time_s: &[f64], win_s: f64, hop_s: f64) -> Result<(), String> {
+    let total = trial_length_s(time_s);
+    if time_s.len() < 2 || total <= win_s + EPS {
+        return Ok(());
+    }
+    let dt = median_dt(time_s);
+    if win_s < MIN_WINDOW_SAMPLES * dt {
+        return Err(format!(
+            "window_s = {win_s} s holds fewer than {MIN_WINDOW_SAMPLES} samples at this trial's median interval of {dt} s; expected a longer window"
+        ));
+    }
+    let count = ((total - win_s) / hop_s).ceil() + 1.0;
+    if !(hop_s > 0.0 && count <= MAX_WINDOWS as f64) {
+        return Err(format!(
+            "window_s = {win_s} s and hop_s = {hop_s} s lay this {total:.1}-s trial out in {count:e} windows; expected at most {MAX_WINDOWS} (a longer hop)"
+        ));
+    }
+    Ok(())
+}
+
+/// The span `[a, b)` a thin window `[start, start + win)` is solved on: widened
+/// by one hop each side (clamped to the trial) until `enough(a, b)` or the span
+/// is the whole trial. The first steps are taken one by one; past them the
+/// number of hops is found by bisection (data only grow as the span widens),
+/// so a window in a long gap costs a logarithmic number of looks, not one per hop.
+fn borrow(
+    start: f64,
+    win_s: f64,
+    hop_s: f64,
+    total: f64,
+    enough: impl Fn(f64, f64) -> bool,
+) -> [f64; 2] {
+    const STEPS: usize = 16;
+    let whole = |a: f64, b: f64| a <= 0.0 && b >= total - EPS;
+    let (mut a, mut b) = (start, start + win_s);
+    for _ in 0..STEPS {
+        a = (a - hop_s).max(0.0);
+        b = (b + hop_s).min(total);
+        if enough(a, b) || whole(a, b) {
+            return [a, b];
+        }
+    }
+    // After `m` more hops each side: the span from `STEPS` hops on, widened.
+    let (a0, b0) = (a, b);
+    let at = |m: f64| [(a0 - m * hop_s).max(0.0), (b0 + m * hop_s).min(total)];
+    let mut hi = (a0.max(total - b0) / hop_s).ceil() + 1.0;
+    let mut lo = 0.0;
+    // `lo` hops are too few; `hi` are enough (or reach the whole trial).
+    while hi - lo > 1.0 {
+        let mid = ((lo + hi) / 2.0).floor();
+        let [x, y] = at(mid);
+        if enough(x, y) || whole(x, y) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    at(hi)
 }
 
 /// The single window of the whole trial (the `basic` variant).
@@ -277,6 +362,59 @@ mod tests {
             "{}",
             notes[0]
         );
+    }
+
+    #[test]
+    fn long_gaps_and_tiny_hops_stay_bounded() {
+        // 4 s of data, a pause of 1e6 s, 4 s more: 33 333 windows, each in the
+        // gap borrowing until it reaches data, found by bisection.
+        let mut t = times(4.0, 100.0);
+        t.extend(times(4.0, 100.0).iter().map(|x| x + 1e6));
+        let w = layout(&t, 60.0, 30.0);
+        assert_eq!(w.len(), 33_333);
+        let mid = &w[w.len() / 2];
+        // 8 s of data in all, less than half a window: the span grows to the whole trial.
+        assert_eq!((mid.first, mid.end), (0, t.len()));
+        assert_eq!(w[0].borrowed_s.unwrap()[0], 0.0);
+        // Settings that would need billions of windows are refused by the check
+        // and bounded by the layout itself.
+        let t = times(100.0, 100.0);
+        assert!(check_layout(&t, 1e-6, 1e-6)
+            .unwrap_err()
+            .contains("fewer than 4 samples"));
+        assert!(check_layout(&t, 1.0, 1e-6).unwrap_err().contains("windows"));
+        assert!(check_layout(&t, 60.0, 30.0).is_ok());
+        assert!(layout(&t, 1.0, 1e-6).len() <= MAX_WINDOWS);
+        assert!(layout(&t, 1.0, 0.0).len() <= MAX_WINDOWS);
+        assert_eq!(layout(&t, f64::NAN, 1.0).len(), 1);
+    }
+
+    #[test]
+    fn bisection_finds_the_span_stepping_would() {
+        // A window deep in a gap needs many hops: stepping one hop at a time
+        // and bisecting agree on the span.
+        let mut t = times(40.0, 50.0);
+        t.extend(times(40.0, 50.0).iter().map(|x| x + 3000.0));
+        let w = layout(&t, 60.0, 10.0);
+        let dt = median_dt(&t);
+        for win in w.iter().filter(|w| w.borrowed_s.is_some()) {
+            let (mut a, mut b) = (win.start_s, win.end_s);
+            let total = trial_length_s(&t);
+            let at = |s: f64| t.partition_point(|&x| x - t[0] < s - EPS);
+            loop {
+                a = (a - 10.0).max(0.0);
+                b = (b + 10.0).min(total);
+                let e = if b >= total - EPS { t.len() } else { at(b) };
+                if (e - at(a)) as f64 * dt >= 30.0 || (a <= 0.0 && b >= total - EPS) {
+                    break;
+                }
+            }
+            let [x, y] = win.borrowed_s.unwrap();
+            assert!(
+                (x - a).abs() < 1e-6 && (y - b).abs() < 1e-6,
+                "{win:?} vs {a} {b}"
+            );
+        }
     }
 
     #[test]

@@ -38,6 +38,7 @@ use std::path::{Path, PathBuf};
 
 /// One movement's axis for one IMU: estimate, reliability and residuals.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct AxisResult {
     /// The movement's label.
     pub movement: String,
@@ -61,6 +62,7 @@ pub struct AxisResult {
 
 /// The calibration of one IMU.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SegmentResult {
     /// IMU name (as in the protocol).
     pub imu: String,
@@ -107,6 +109,7 @@ impl SegmentResult {
 
 /// An IMU of the protocol that could not be calibrated, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SkippedSegment {
     pub imu: String,
     pub reason: String,
@@ -115,6 +118,7 @@ pub struct SkippedSegment {
 /// A whole calibration: what it was computed from, and per IMU the result.
 /// Saved as TOML (`<recording stem>.calibration.toml`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Calibration {
     pub program: String,
     pub version: String,
@@ -312,10 +316,9 @@ impl Calibration {
         for s in &c.segments {
             let n = s.q.iter().map(|v| v * v).sum::<f64>().sqrt();
             if !(n.is_finite() && (n - 1.0).abs() < 1e-3) {
-                return Err(CalibrationError::file(
-                    origin,
-                    format!("IMU '{}': q is not a unit quaternion (norm {n})", s.imu),
-                ));
+                let message = format!("IMU '{}': q is not a unit quaternion (norm {n})", s.imu);
+                let line = crate::input::line_naming(text, &message).unwrap_or(0);
+                return Err(CalibrationError::at(origin, line, 1, message));
             }
         }
         Ok(c)
@@ -324,16 +327,21 @@ impl Calibration {
     /// Reads a calibration file.
     pub fn load(path: &Path) -> Result<Calibration, CalibrationError> {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CalibrationError::file(&origin, format!("cannot read: {e}")))?;
+        let text = crate::input::read_text_located(path).map_err(|e| {
+            CalibrationError::at(
+                &origin,
+                e.line,
+                e.column,
+                format!("cannot read: {}", e.error),
+            )
+        })?;
         Calibration::from_toml(&text, &origin)
     }
 
     /// Writes the calibration file atomically (the previous one kept as `.bak`).
-    pub fn save(&self, path: &Path) -> Result<(), CalibrationError> {
-        crate::save::atomic_write(path, self.to_toml().as_bytes()).map_err(|e| {
-            CalibrationError::file(path.display().to_string(), format!("cannot write: {e}"))
-        })
+    pub fn save(&self, path: &Path) -> Result<(), crate::save::WriteError> {
+        crate::save::atomic_write(path, self.to_toml().as_bytes())
+            .map_err(|e| crate::save::WriteError::io(path, &e))
     }
 
     /// What applying it to a trial does: per IMU the rotation. `text` is the
@@ -384,7 +392,7 @@ impl AppliedCalibration {
     /// Reads a calibration file and records what applying it means.
     pub fn load(path: &Path) -> Result<AppliedCalibration, CalibrationError> {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path)
+        let text = crate::input::read_text(path)
             .map_err(|e| CalibrationError::file(&origin, format!("cannot read: {e}")))?;
         let c = Calibration::from_toml(&text, &origin)?;
         Ok(c.applied(&origin, &text))

@@ -140,7 +140,7 @@ impl Protocol {
         if let Some(p) = Protocol::builtin(name_or_path) {
             return Ok(p);
         }
-        let text = std::fs::read_to_string(name_or_path).map_err(|e| {
+        let text = crate::input::read_text(std::path::Path::new(name_or_path)).map_err(|e| {
             CalibrationError::file(
                 name_or_path,
                 format!(

@@ -99,7 +99,7 @@ impl Recording {
     /// Reads a recording (gzip when the name ends in `.gz`).
     pub fn read(path: &Path) -> Result<Recording, CalibrationError> {
         let origin = path.display().to_string();
-        let raw = std::fs::read(path)
+        let raw = crate::input::read_bytes(path)
             .map_err(|e| CalibrationError::file(&origin, format!("cannot read: {e}")))?;
         let gz = origin.to_ascii_lowercase().ends_with(".gz");
         let bytes = if gz {

@@ -112,6 +112,16 @@ pub struct Context {
     pub glitch_deg: f64,
 }
 
+impl Context {
+    /// Checks the drift windows suit `trial` (enough samples per window, not
+    /// too many windows); `file` names the trial in the error.
+    pub fn check_trial(&self, trial: &Trial, file: &Path) -> anyhow::Result<()> {
+        let s = &self.settings;
+        acm_workbench::acm::window::check_layout(&trial.time_s, s.window_s, s.hop_s)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))
+    }
+}
+
 /// The folder of limit tables the program uses when none is named: `./joint_limits`.
 pub fn default_limits_dir() -> PathBuf {
     PathBuf::from("joint_limits")

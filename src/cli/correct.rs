@@ -34,6 +34,10 @@ pub struct CorrectArgs {
     /// (reproduces that run exactly).
     #[arg(long, conflicts_with_all = ["variant", "model", "limits", "lambda1", "window", "hop", "pose_calibration"])]
     pub from_sidecar: Option<PathBuf>,
+    /// With --from-sidecar: run even when the input's SHA-256 differs from the
+    /// one the sidecar records (another trial, or an edited one); says so.
+    #[arg(long, requires = "from_sidecar")]
+    pub force: bool,
     /// Apply this functional calibration (`acmw calibrate`) to the trial first.
     #[arg(long, conflicts_with = "from_sidecar")]
     pub calibration: Option<PathBuf>,
@@ -52,6 +56,22 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     let (ctx, variant, pose) = match &args.from_sidecar {
         Some(p) => {
             let s = Sidecar::load(p)?;
+            let origin = p.display().to_string();
+            s.check(&origin)?;
+            let found = s.check_input(&args.input)?;
+            if let Some(found) = found {
+                let what = format!(
+                    "{}: SHA-256 {found} differs from the {} that {origin} records for {}",
+                    args.input.display(),
+                    s.input.sha256,
+                    s.input.file
+                );
+                anyhow::ensure!(
+                    args.force,
+                    "{what}; expected the trial the sidecar was made from (--force runs anyway)"
+                );
+                eprintln!("warning: {what}; running anyway (--force)");
+            }
             recorded_calibration = s
                 .calibration
                 .as_ref()
@@ -78,6 +98,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     };
     let (in_format, gzip) = detect_format(&args.input)?;
     let mut trial = read_trial(&args.input, &ctx.model)?;
+    ctx.check_trial(&trial, &args.input)?;
     let calibration = match recorded_calibration {
         Some(c) => {
             for w in c.apply(&mut trial, &ctx.model) {

@@ -152,14 +152,14 @@ fn workbench(
     let model = model
         .map(|m| acm_workbench::model::Model::load(&m))
         .transpose()?;
-    acm_workbench::ui::runtime::run(acm_workbench::ui::runtime::Options {
+    let signal = acm_workbench::ui::runtime::run(acm_workbench::ui::runtime::Options {
         dir: dir.unwrap_or_else(|| PathBuf::from("sample_trials")),
         limits_dir: limits_dir.unwrap_or_else(common::default_limits_dir),
         model,
         poll: poll.map(std::time::Duration::from_secs_f64),
         theme,
     })?;
-    Ok(EXIT_OK)
+    Ok(signal.map_or(EXIT_OK, acm_workbench::ui::signals::exit_status))
 }
 
 /// A polling interval in seconds: positive and at most a day.

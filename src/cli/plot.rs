@@ -108,6 +108,7 @@ pub fn joint_series<'m>(
         None
     } else {
         let settings: Settings = ctx.settings;
+        ctx.check_trial(trial, std::path::Path::new(&trial.name))?;
         let c = correct_trial(
             trial,
             &ctx.model,

@@ -87,6 +87,7 @@ fn positive_deg(s: &str) -> Result<f64, String> {
 pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     let ctx = load_context(&args.engine, Some(&args.input))?;
     let mut trial = read_trial(&args.input, &ctx.model)?;
+    ctx.check_trial(&trial, &args.input)?;
     super::calibrate::apply(
         args.calibration.as_deref(),
         &mut trial,

@@ -123,7 +123,7 @@ pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
     if is_xsens_path(path) {
         super::xsens_trial::input_bytes(path)
     } else {
-        std::fs::read(path)
+        crate::input::read_bytes(path)
     }
 }
 
@@ -193,27 +193,31 @@ fn to_text(bytes: Vec<u8>, origin: &str, kind: Kind, gzip: bool) -> Result<Strin
     })
 }
 
-/// Reads and decompresses the whole file.
-fn read_text(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> {
+/// Reads and decompresses the whole file; also a warning when the sidecar
+/// beside it describes another version of it.
+fn read_text(path: &Path, kind: Kind, gzip: bool) -> Result<(String, Option<String>), TrialError> {
     let origin = origin_of(path);
-    let raw = std::fs::read(path).map_err(|e| cannot_read(&origin, e))?;
+    let raw = crate::input::read_bytes(path).map_err(|e| cannot_read(&origin, e))?;
+    let stale = crate::sidecar::mismatch_warning(path, &raw);
     let bytes = if gzip {
-        let mut out = Vec::with_capacity(raw.len().saturating_mul(4));
-        flate2::read::MultiGzDecoder::new(&raw[..])
-            .read_to_end(&mut out)
-            .map_err(|e| bad_gzip(&origin, e))?;
-        out
+        crate::input::gunzip_capped(&raw).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::InvalidData && e.to_string().contains("more than") {
+                TrialError::file(&origin, format!("cannot read: {e}"))
+            } else {
+                bad_gzip(&origin, e)
+            }
+        })?
     } else {
         raw
     };
-    to_text(bytes, &origin, kind, gzip)
+    Ok((to_text(bytes, &origin, kind, gzip)?, stale))
 }
 
 /// Reads only the header lines: for CSV the first non-blank line, for `.sto` up to
 /// the first non-blank line after `endheader`.
 fn read_head(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> {
     let origin = origin_of(path);
-    let file = std::fs::File::open(path).map_err(|e| cannot_read(&origin, e))?;
+    let file = crate::input::open_regular(path).map_err(|e| cannot_read(&origin, e))?;
     let mut reader: Box<dyn BufRead> = if gzip {
         Box::new(BufReader::new(flate2::read::MultiGzDecoder::new(
             BufReader::new(file),
@@ -286,13 +290,15 @@ pub fn read_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
         return super::xsens_trial::read_xsens_trial(path, model);
     }
     let (kind, gzip) = kind_or_err(path)?;
-    let text = read_text(path, kind, gzip)?;
+    let (text, stale) = read_text(path, kind, gzip)?;
     let format = match kind {
         Kind::Sto => TrialFormat::Sto,
         Kind::Csv => first_header(&text).map_or(TrialFormat::QuatCsv, classify_csv_header),
     };
     let origin = origin_of(path);
-    parse_trial(&text, &origin, &name_of(&origin), format, model)
+    let mut trial = parse_trial(&text, &origin, &name_of(&origin), format, model)?;
+    trial.warnings.extend(stale);
+    Ok(trial)
 }
 
 /// Reads a trial from text in `format`; `origin` names the file in errors, and its
@@ -342,12 +348,19 @@ pub fn read_trial_header(path: &Path, model: &Model) -> Result<TrialHeader, Tria
 
 /// Writes a trial in `format`; gzip-compressed when the path ends in `.gz`.
 /// Atomic, keeping the previous file as `<name>.bak` ([`crate::save::atomic_write`]).
-pub fn write_trial(trial: &Trial, path: &Path, format: TrialFormat) -> Result<(), TrialError> {
+pub fn write_trial(
+    trial: &Trial,
+    path: &Path,
+    format: TrialFormat,
+) -> Result<(), crate::save::WriteError> {
     let origin = origin_of(path);
+    let refused = |message: String| crate::save::WriteError {
+        path: origin.clone(),
+        message,
+    };
     if format == TrialFormat::Xsens {
-        return Err(TrialError::file(
-            origin,
-            "cannot write Xsens exports: expected quat-csv, euler-csv or sto",
+        return Err(refused(
+            "cannot write Xsens exports: expected quat-csv, euler-csv or sto".into(),
         ));
     }
     if let Some(bad) = trial.imus.iter().find(|s| {
@@ -355,30 +368,24 @@ pub fn write_trial(trial: &Trial, path: &Path, format: TrialFormat) -> Result<()
             .as_ref()
             .is_some_and(|g| g.len() != trial.time_s.len())
     }) {
-        return Err(TrialError::file(
-            origin,
-            format!(
-                "cannot write: IMU '{}' has {} gyroscope readings, expected one per time ({})",
-                bad.name,
-                bad.gyro.as_ref().map_or(0, Vec::len),
-                trial.time_s.len()
-            ),
-        ));
+        return Err(refused(format!(
+            "cannot write: IMU '{}' has {} gyroscope readings, expected one per time ({})",
+            bad.name,
+            bad.gyro.as_ref().map_or(0, Vec::len),
+            trial.time_s.len()
+        )));
     }
     if let Some(bad) = trial
         .imus
         .iter()
         .find(|s| s.orientation.len() != trial.time_s.len())
     {
-        return Err(TrialError::file(
-            origin,
-            format!(
-                "cannot write: IMU '{}' has {} samples, expected one per time ({})",
-                bad.name,
-                bad.orientation.len(),
-                trial.time_s.len()
-            ),
-        ));
+        return Err(refused(format!(
+            "cannot write: IMU '{}' has {} samples, expected one per time ({})",
+            bad.name,
+            bad.orientation.len(),
+            trial.time_s.len()
+        )));
     }
     let (kind, gzip) = match kind_of_name(path) {
         Some((k, gz)) => (Some(k), gz),
@@ -393,25 +400,21 @@ pub fn write_trial(trial: &Trial, path: &Path, format: TrialFormat) -> Result<()
         Kind::Csv
     };
     if kind.is_some_and(|k| k != wanted) {
-        return Err(TrialError::file(
-            origin,
-            format!(
-                "cannot write {format:?} to this file name: expected a name ending in .{}",
-                if wanted == Kind::Sto { "sto" } else { "csv" }
-            ),
-        ));
+        return Err(refused(format!(
+            "cannot write {format:?} to this file name: expected a name ending in .{}",
+            if wanted == Kind::Sto { "sto" } else { "csv" }
+        )));
     }
     let text = trial_to_string(trial, format);
     let bytes = if gzip {
         let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
         enc.write_all(text.as_bytes())
             .and_then(|_| enc.finish())
-            .map_err(|e| TrialError::file(origin.clone(), format!("cannot compress: {e}")))?
+            .map_err(|e| refused(format!("cannot compress: {e}")))?
     } else {
         text.into_bytes()
     };
-    crate::save::atomic_write(path, &bytes)
-        .map_err(|e| TrialError::file(origin, format!("cannot write: {e}")))
+    crate::save::atomic_write(path, &bytes).map_err(|e| crate::save::WriteError::io(path, &e))
 }
 
 /// The text of a trial in `format` (uncompressed). Numbers use Rust's shortest

@@ -15,6 +15,72 @@ pub const GAP_FACTOR: f64 = 3.0;
 /// stream irregular (printing times with 3 decimals at 100 Hz stays within it).
 pub const IRREGULAR_FRACTION: f64 = 0.01;
 
+/// Largest magnitude of a sample time, seconds (about 317 years): absolute
+/// clocks in seconds since 1970 fit, nanosecond counters do not (at 1e18 an
+/// f64 cannot tell neighbouring samples apart).
+pub const MAX_ABS_TIME_S: f64 = 1e10;
+
+/// Longest trial span (last time minus first), seconds: 115 days.
+pub const MAX_SPAN_S: f64 = 1e7;
+
+/// Shortest median sample interval, seconds (a 100 kHz stream).
+pub const MIN_MEDIAN_DT_S: f64 = 1e-5;
+
+/// Longest median sample interval, seconds (one sample an hour).
+pub const MAX_MEDIAN_DT_S: f64 = 3600.0;
+
+/// Why a time axis cannot be a trial's, if it cannot: every time finite and
+/// within [`MAX_ABS_TIME_S`], strictly increasing, a span of at most
+/// [`MAX_SPAN_S`] and a median interval in
+/// [[`MIN_MEDIAN_DT_S`], [`MAX_MEDIAN_DT_S`]]. Returns the index of the
+/// offending sample (0 for the axis as a whole) and what was expected.
+pub fn check_time_axis(time_s: &[f64]) -> Result<(), (usize, String)> {
+    let Some(&t0) = time_s.first() else {
+        return Ok(());
+    };
+    for (i, &t) in time_s.iter().enumerate() {
+        if !(t.is_finite() && t.abs() <= MAX_ABS_TIME_S) {
+            return Err((
+                i,
+                format!("expected a time within +-{MAX_ABS_TIME_S:e} s, found {t}"),
+            ));
+        }
+        if i > 0 && t <= time_s[i - 1] {
+            return Err((
+                i,
+                format!(
+                    "time {t} does not follow the previous time {}; expected times to strictly increase",
+                    time_s[i - 1]
+                ),
+            ));
+        }
+        if t - t0 > MAX_SPAN_S {
+            return Err((
+                i,
+                format!(
+                    "time {t} is {:e} s after the first sample ({t0}); expected a trial of at most {MAX_SPAN_S:e} s",
+                    t - t0
+                ),
+            ));
+        }
+    }
+    if time_s.len() >= 2 {
+        let dt = super::median_dt(time_s);
+        if !(MIN_MEDIAN_DT_S..=MAX_MEDIAN_DT_S).contains(&dt) {
+            return Err((
+                0,
+                format!(
+                    "median sample interval {dt:e} s (rate {:e} Hz): expected a rate between {:e} Hz and {:e} Hz",
+                    1.0 / dt,
+                    1.0 / MAX_MEDIAN_DT_S,
+                    1.0 / MIN_MEDIAN_DT_S
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// A stretch without samples.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Gap {

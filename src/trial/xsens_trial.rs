@@ -29,7 +29,7 @@ pub struct XsensSource {
 }
 
 fn read_text(path: &Path) -> Result<String, TrialError> {
-    std::fs::read_to_string(path)
+    crate::input::read_text(path)
         .map_err(|e| TrialError::file(path.display().to_string(), format!("cannot read: {e}")))
 }
 
@@ -124,6 +124,35 @@ fn export_in(dir: &Path, stem: &str) -> PathBuf {
     }
 }
 
+/// True when `name` names a file in a folder, not a path out of it.
+fn is_plain_file_name(name: &str) -> bool {
+    !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\', '\0'])
+        && !name.contains(':')
+}
+
+/// Every export a mapping names is a plain file name (trial_prefix + name +
+/// `.txt`), so that a mapping never reads files outside its folders.
+fn check_export_names(xml: &Path, mapping: &Mapping) -> Result<(), TrialError> {
+    for s in &mapping.sensors {
+        let file = format!("{}{}", mapping.trial_prefix, s.file_suffix);
+        if !is_plain_file_name(&file) {
+            return Err(TrialError::at(
+                xml.display().to_string(),
+                s.line,
+                1,
+                format!(
+                    "sensor '{}': export name {file:?} (trial_prefix + name) leaves the mapping's folder; expected a plain file name",
+                    s.file_suffix
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn files_of_mapping(
     xml: &Path,
     mapping: &Mapping,
@@ -160,6 +189,7 @@ fn files_of_mapping(
 fn resolve_mapping(xml: &Path) -> Result<XsensSource, TrialError> {
     let origin = xml.display().to_string();
     let mapping = parse_mapping(&read_text(xml)?, &origin)?;
+    check_export_names(xml, &mapping)?;
     let folder = export_folder(xml, &mapping).ok_or_else(|| {
         let s = &mapping.sensors[0];
         TrialError::at(
@@ -186,12 +216,15 @@ fn mapping_for_folder(dir: &Path) -> Option<PathBuf> {
         .into_iter()
         .chain(parent.map(sorted_entries).unwrap_or_default());
     for xml in candidates.filter(|p| is_mapping_file(p)) {
-        let Ok(text) = std::fs::read_to_string(&xml) else {
+        let Ok(text) = crate::input::read_text(&xml) else {
             continue;
         };
         let Ok(m) = parse_mapping(&text, "") else {
             continue;
         };
+        if check_export_names(&xml, &m).is_err() {
+            continue;
+        }
         let first = format!("{}{}", m.trial_prefix, m.sensors[0].file_suffix);
         if export_in(dir, &first).is_file() {
             return Some(xml);
@@ -288,10 +321,10 @@ pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
     let source = resolve(path).map_err(|e| std::io::Error::other(e.to_string()))?;
     let mut out = Vec::new();
     if let Some((xml, _)) = &source.mapping {
-        out.extend(std::fs::read(xml)?);
+        out.extend(crate::input::read_bytes(xml)?);
     }
     for (f, _) in &source.files {
-        out.extend(std::fs::read(f)?);
+        out.extend(crate::input::read_bytes(f)?);
     }
     Ok(out)
 }
@@ -420,6 +453,7 @@ fn common_rate(exports: &[(String, XsensExport)]) -> Result<f64, TrialError> {
     let mut rate: Option<(f64, &str)> = None;
     for (_, e) in exports {
         if let Some(r) = e.rate_hz {
+            check_rate(r, &e.origin)?;
             match rate {
                 None => rate = Some((r, &e.origin)),
                 Some((r0, o0)) if (r - r0).abs() > 1e-9 * r0 => {
@@ -438,9 +472,14 @@ fn common_rate(exports: &[(String, XsensExport)]) -> Result<f64, TrialError> {
         return Ok(r);
     }
     // No `Update Rate` comment anywhere: the first export's SampleTimeFine.
-    exports
+    let found = exports
         .iter()
-        .find_map(|(_, e)| e.sample_time_rate_hz)
+        .find_map(|(_, e)| Some((e.sample_time_rate_hz?, &e.origin)));
+    if let Some((r, origin)) = found {
+        check_rate(r, origin)?;
+    }
+    found
+        .map(|(r, _)| r)
         .ok_or_else(|| {
             TrialError::at(
                 &exports[0].1.origin,
@@ -462,6 +501,22 @@ fn frame_warning(exports: &[(String, XsensExport)]) -> Option<String> {
             )
         })
     })
+}
+
+/// The update rate of an export is a rate a trial can have: finite, with a
+/// sample interval within the bounds every reader keeps to.
+fn check_rate(rate_hz: f64, origin: &str) -> Result<(), TrialError> {
+    use crate::trial::timing::{MAX_MEDIAN_DT_S, MIN_MEDIAN_DT_S};
+    let (lo, hi) = (1.0 / MAX_MEDIAN_DT_S, 1.0 / MIN_MEDIAN_DT_S);
+    if rate_hz.is_finite() && (lo..=hi).contains(&rate_hz) {
+        return Ok(());
+    }
+    Err(TrialError::at(
+        origin,
+        1,
+        1,
+        format!("update rate {rate_hz} Hz: expected a finite rate between {lo:e} Hz and {hi:e} Hz"),
+    ))
 }
 
 /// Runs of counters missing inside a file, as `(first missing, count)`.
@@ -520,6 +575,12 @@ pub(crate) fn assemble(
         if idx.len() == exports.len() {
             kept.push((c, idx));
         }
+    }
+    if kept.is_empty() {
+        return Err(TrialError::file(
+            exports[0].1.origin.clone(),
+            format!("the sensors share no packet between counters {start} and {end}: expected exports of one recording with at least one packet every sensor recorded"),
+        ));
     }
     let firsts: Vec<u64> = exports.iter().map(|(_, e)| e.counters[0]).collect();
     let lasts: Vec<u64> = exports
@@ -610,12 +671,19 @@ pub(crate) fn assemble(
             .map(|g| kept.iter().map(|(_, idx)| g[idx[k]]).collect());
         imus.push(ImuSeries::new(canonical, orientation).with_gyro(gyro));
     }
+    let time_s: Vec<f64> = kept
+        .iter()
+        .map(|(c, _)| (c - start) as f64 / rate)
+        .collect();
+    if let Err((i, message)) = crate::trial::timing::check_time_axis(&time_s) {
+        return Err(TrialError::file(
+            exports[0].1.origin.clone(),
+            format!("packet {}: {message}", kept[i].0),
+        ));
+    }
     Ok(Trial {
         name: name.to_string(),
-        time_s: kept
-            .iter()
-            .map(|(c, _)| (c - start) as f64 / rate)
-            .collect(),
+        time_s,
         imus,
         warnings,
     })

@@ -23,6 +23,7 @@ pub mod pose;
 pub mod render;
 pub mod runtime;
 pub mod screens;
+pub mod signals;
 pub mod theme;
 pub mod workbench;
 

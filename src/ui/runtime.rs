@@ -71,20 +71,17 @@ pub struct Options {
     pub theme: Theme,
 }
 
-/// Runs the workbench until the user quits (or a signal ends it).
-pub fn run(opts: Options) -> anyhow::Result<()> {
+/// Runs the workbench until the user quits or a signal ends it; returns the
+/// signal's number in that case.
+pub fn run(opts: Options) -> anyhow::Result<Option<i32>> {
     // Listing names is fast; the trials are read in the background.
     let files = list_trials(&opts.dir).map_err(anyhow::Error::msg)?;
     let limits = load_limits(&opts.limits_dir).map_err(anyhow::Error::msg)?;
     let label = opts.dir.display().to_string();
     let mut app = App::new(label, opts.dir.clone(), files, limits);
     app.model = opts.model.clone().map(Arc::new);
-
-    let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        restore_terminal();
-        hook(info);
-    }));
+    super::signals::offer_back(&mut app);
+    super::signals::install(restore_terminal);
     terminal::enable_raw_mode()?;
     execute!(stdout(), EnterAlternateScreen, EnableMouseCapture)?;
     let result = event_loop(&mut app, &opts);
@@ -264,7 +261,12 @@ impl Workers {
                     use rayon::prelude::*;
                     files.par_iter().for_each(|(f, p)| {
                         let m = model.as_deref();
-                        let msg = jobs::load_trial(f, p, &limits, glitch_deg, m);
+                        let msg = match super::signals::caught(|| {
+                            Ok(jobs::load_trial(f, p, &limits, glitch_deg, m))
+                        }) {
+                            Ok(msg) => msg,
+                            Err(e) => Msg::Loaded(f.clone(), Err(e)),
+                        };
                         let _ = tx.send(Event::Msg(msg));
                     });
                 });
@@ -286,7 +288,13 @@ impl Workers {
                             }));
                         }
                     };
-                    let msg = jobs::run_job(&job, &cancel, &progress);
+                    let msg =
+                        super::signals::caught(|| Ok(jobs::run_job(&job, &cancel, &progress)))
+                            .unwrap_or_else(|e| Msg::RunDone {
+                                file: job.file.clone(),
+                                gen: job.gen,
+                                result: Err(e),
+                            });
                     let _ = tx.send(Event::Msg(msg));
                 });
             }
@@ -313,7 +321,7 @@ fn draw(
     execute!(stdout(), EndSynchronizedUpdate)
 }
 
-fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
+fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<Option<i32>> {
     let (tx, rx): (Sender<Event>, Receiver<Event>) = unbounded();
     let mut terminal = Terminal::new(CrosstermBackend::new(stdout()))?;
     terminal.clear()?;
@@ -369,10 +377,13 @@ fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
         for ev in batch {
             match ev {
                 Event::Signal(s) => {
-                    if s == signal_hook::consts::SIGHUP && app.limits.dirty() {
-                        keep_unsaved(app);
+                    // Edits are kept whatever the signal; a failure to keep
+                    // them cannot be shown any more, only printed.
+                    if let Err(e) = super::signals::keep_unsaved(&app.limits) {
+                        restore_terminal();
+                        eprintln!("acmw: cannot keep the unsaved limit edits: {e}");
                     }
-                    return Ok(());
+                    return Ok(Some(s));
                 }
                 Event::Msg(m) => {
                     let saved_limits = matches!(m, Msg::LimitsSaved(Ok(_)));
@@ -391,20 +402,11 @@ fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<()> {
             }
         }
         if app.quit {
-            return Ok(());
+            return Ok(None);
         }
         draw(&mut terminal, app, &opts.theme)?;
     }
-    Ok(())
-}
-
-/// On SIGHUP (an SSH drop), unsaved limit edits go beside the table as
-/// `<table>.unsaved` instead of being lost.
-fn keep_unsaved(app: &App) {
-    let l = &app.limits;
-    let _ = std::fs::create_dir_all(&l.dir);
-    let path = l.dir.join(format!("{}.unsaved", l.table_name));
-    let _ = crate::save::atomic_write(&path, l.table.to_csv().as_bytes());
+    Ok(None)
 }
 
 #[cfg(test)]

@@ -525,6 +525,8 @@ struct Acc<'a> {
     origin: &'a str,
     time: Vec<f64>,
     last_line: u64,
+    /// Line of each sample, to locate time-axis errors.
+    lines: Vec<u64>,
     series: Vec<Vec<Quat>>,
     /// Gyroscope readings per IMU (empty for IMUs without gyroscope columns).
     gyro: Vec<Vec<Vector3<f64>>>,
@@ -537,6 +539,7 @@ impl<'a> Acc<'a> {
             origin,
             time: Vec::new(),
             last_line: 0,
+            lines: Vec::new(),
             series: vec![Vec::new(); n_imus],
             gyro: vec![Vec::new(); n_imus],
             renorm: vec![Renorm::default(); n_imus],
@@ -561,6 +564,7 @@ impl<'a> Acc<'a> {
             }
         }
         self.time.push(t);
+        self.lines.push(line);
         self.last_line = line;
         Ok(())
     }
@@ -622,6 +626,10 @@ impl<'a> Acc<'a> {
                     layout.header_line
                 ),
             ));
+        }
+        if let Err((i, message)) = crate::trial::timing::check_time_axis(&self.time) {
+            let line = if i == 0 { self.lines[0] } else { self.lines[i] };
+            return Err(TrialError::at(self.origin, line, 1, message));
         }
         let mut warnings = layout.warnings;
         let n = self.time.len();

@@ -11,7 +11,7 @@ pub const FOLDER_PROTOCOL: &str = "protocol.toml";
 /// Reads and calibrates every recording in `dir` with the folder's
 /// `protocol.toml`, or the built-in protocol when there is none.
 pub fn scan(dir: &Path) -> Msg {
-    let (protocol, label) = match std::fs::read_to_string(dir.join(FOLDER_PROTOCOL)) {
+    let (protocol, label) = match crate::input::read_text(&dir.join(FOLDER_PROTOCOL)) {
         Ok(text) => (
             Protocol::from_toml(&text, FOLDER_PROTOCOL).map_err(|e| e.to_string()),
             FOLDER_PROTOCOL.to_string(),

@@ -73,7 +73,7 @@ pub fn limits_state(dir: &Path, d: LimitsDir) -> LimitsState {
 
 /// Reads the limit files in `dir` as they are on disk now (None if absent or bad).
 pub fn read_limits_on_disk(dir: &Path, table_name: &str) -> Option<Msg> {
-    let s = std::fs::read_to_string(dir.join("settings.toml")).ok()?;
+    let s = crate::input::read_text(&dir.join("settings.toml")).ok()?;
     let settings = match SettingsFile::parse(&s, "settings.toml") {
         Ok(s) => s,
         Err(e) => return Some(Msg::LimitsInvalid(e.to_string())),
@@ -189,6 +189,8 @@ pub fn run_job(job: &RunJob, cancel: &AtomicBool, progress: &(dyn Fn(u8) + Sync)
     let l = &job.loaded;
     let n = Variant::ALL.len();
     let result = (|| {
+        let s = &job.settings;
+        crate::acm::window::check_layout(&l.trial.time_s, s.window_s, s.hop_s)?;
         let mut out: Vec<Arc<Correction>> = Vec::with_capacity(n);
         for (k, v) in Variant::ALL.into_iter().enumerate() {
             let report = move |done: usize, total: usize| {
@@ -288,11 +290,13 @@ pub fn save_limits(dir: &Path, table_name: &str, table_csv: &str, settings_toml:
     let result = (|| {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         let table: PathBuf = dir.join(table_name);
-        crate::save::atomic_write(&table, table_csv.as_bytes())
-            .map_err(|e| format!("{}: {e}", table.display()))?;
         let settings = dir.join("settings.toml");
-        crate::save::atomic_write(&settings, settings_toml.as_bytes())
-            .map_err(|e| format!("{}: {e}", settings.display()))?;
+        // One commit: the table and the settings naming it change together.
+        crate::save::atomic_write_all(&[
+            (&table, table_csv.as_bytes()),
+            (&settings, settings_toml.as_bytes()),
+        ])
+        .map_err(|e| format!("{}: cannot write: {e}", table.display()))?;
         Ok(table.display().to_string())
     })();
     Msg::LimitsSaved(result)
