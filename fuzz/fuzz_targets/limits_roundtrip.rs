@@ -5,9 +5,12 @@ use acm_workbench::limits::LimitTable;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
     if let Ok(table) = LimitTable::parse(text, "l.csv") {
-        let back = LimitTable::parse(&table.to_csv(), "again.csv").expect("a written table reads back");
+        let back =
+            LimitTable::parse(&table.to_csv(), "again.csv").expect("a written table reads back");
         assert_eq!(back.rows, table.rows);
         assert_eq!(back.hash(), table.hash());
     }

@@ -5,7 +5,9 @@ use acm_workbench::trial::{read_trial_from_str, trial_to_string, TrialFormat};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
     let model = Model::infant13();
     if let Ok(trial) = read_trial_from_str(text, "f.sto", TrialFormat::Sto, &model) {
         let again = trial_to_string(&trial, TrialFormat::Sto);

@@ -5,7 +5,9 @@ use acm_workbench::trial::xsens::parse_export;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
     let _ = parse_mapping(text, "m.xml");
     let _ = parse_export(text, "e.txt");
 });
