@@ -8,6 +8,7 @@ pub mod acm;
 pub mod analysis;
 pub mod baselines;
 pub mod calibration;
+pub mod correct;
 pub mod ik;
 pub mod input;
 pub mod limits;
