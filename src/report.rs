@@ -91,10 +91,7 @@ pub struct ReportInput<'a> {
 
 impl ReportInput<'_> {
     /// Figures of the uncorrected trial and of already computed corrections.
-    pub fn report<'c>(
-        &self,
-        corrections: impl IntoIterator<Item = &'c Correction>,
-    ) -> TrialReport {
+    pub fn report<'c>(&self, corrections: impl IntoIterator<Item = &'c Correction>) -> TrialReport {
         let corrections: Vec<&Correction> = corrections.into_iter().collect();
         let t = self.trial;
         TrialReport {

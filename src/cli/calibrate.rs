@@ -4,8 +4,7 @@
 
 use acm_workbench::calibration::simulate::{self, CalibSimConfig, Sloppiness};
 use acm_workbench::calibration::{
-    calibrate, default_output, Calibration, Protocol, Recording,
-    DEFAULT_PROTOCOL_NAME,
+    calibrate, default_output, Calibration, Protocol, Recording, DEFAULT_PROTOCOL_NAME,
 };
 use acm_workbench::rotation::{angle_between_deg, angle_deg, Quat};
 use clap::Args;

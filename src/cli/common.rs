@@ -6,6 +6,8 @@ use acm_workbench::limits::{LimitTable, LimitsDir, Settings};
 use acm_workbench::model::{Model, SignedAxis};
 use acm_workbench::pose::{PoseCalibration, PoseTime};
 use acm_workbench::trial::detect_model;
+use acm_workbench::variant::{Variant, VARIANTS};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -144,7 +146,11 @@ impl Context {
 
     /// Checks the drift windows suit `trial` (enough samples per window, not
     /// too many windows); `file` names the trial in the error.
-    pub fn check_trial(&self, trial: &acm_workbench::trial::Trial, file: &Path) -> anyhow::Result<()> {
+    pub fn check_trial(
+        &self,
+        trial: &acm_workbench::trial::Trial,
+        file: &Path,
+    ) -> anyhow::Result<()> {
         let s = &self.settings;
         acm_workbench::acm::window::check_layout(&trial.time_s, s.window_s, s.hop_s)
             .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))
@@ -242,4 +248,13 @@ impl Progress {
             eprintln!();
         }
     }
+}
+
+/// The parser of `--variant`: the variant table's names, each with its
+/// description in `--help`.
+pub fn variant_parser() -> impl TypedValueParser<Value = Variant> {
+    let names = VARIANTS
+        .iter()
+        .map(|r| PossibleValue::new(r.name).help(r.description));
+    PossibleValuesParser::new(names).map(|s| Variant::from_name(&s).expect("a name of the table"))
 }

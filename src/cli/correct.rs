@@ -1,8 +1,8 @@
 //! `acmw correct`: correct a trial, write the corrected trial and its sidecar.
 
 use super::common::{
-    load_calibration, load_context, load_prepared, set_threads, Context, EngineArgs, PoseArgs,
-    Progress,
+    load_calibration, load_context, load_prepared, set_threads, variant_parser, Context,
+    EngineArgs, PoseArgs, Progress,
 };
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation};
@@ -24,7 +24,7 @@ pub struct CorrectArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Correction variant.
-    #[arg(long, value_enum, default_value_t = Variant::DriftCentroid)]
+    #[arg(long, value_parser = variant_parser(), default_value = "drift-centroid")]
     pub variant: Variant,
     /// Output format [default: the input's].
     #[arg(long, value_enum)]
@@ -104,8 +104,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     };
     let announce = args.from_sidecar.is_none();
     let preparation = Preparation { calibration, pose };
-    let (source, prepared) =
-        load_prepared(&ctx, &args.input, &preparation, announce, args.quiet)?;
+    let (source, prepared) = load_prepared(&ctx, &args.input, &preparation, announce, args.quiet)?;
     let trial = &prepared.trial;
     if !args.quiet {
         for w in &trial.warnings {

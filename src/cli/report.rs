@@ -1,6 +1,8 @@
 //! `acmw report`: the figures of docs/method.md section 16 before and after each variant.
 
-use super::common::{load_calibration, load_context, load_prepared, EngineArgs, PoseArgs, Progress};
+use super::common::{
+    load_calibration, load_context, load_prepared, EngineArgs, PoseArgs, Progress,
+};
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation};
 use acm_workbench::reference::{compare, read_reference, CompareOptions};
@@ -18,7 +20,7 @@ pub struct ReportArgs {
     /// one IMU); a folder of such exports; or an OpenSense mapping `.xml` naming them.
     pub input: PathBuf,
     /// Variants to run and compare (repeatable) [default: all].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::common::variant_parser())]
     pub variant: Vec<Variant>,
     /// Flag orientation jumps larger than this between neighbouring samples,
     /// degrees [default: `glitch_deg` in ./joint_limits/settings.toml, else 30].
