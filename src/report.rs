@@ -3,9 +3,7 @@
 
 use crate::acm::hinge::HingeRecord;
 use crate::acm::window::{borrow_notes, layout};
-use crate::acm::{
-    correct_trial, Cancelled, Correction, ImuHeading, RunControl, SkippedJoint, Variant,
-};
+use crate::acm::{Correction, ImuHeading, SkippedJoint, Variant};
 use crate::ik::IkSummary;
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::{trial_figures, JointFigures};
@@ -93,7 +91,8 @@ pub struct ReportInput<'a> {
 
 impl ReportInput<'_> {
     /// Figures of the uncorrected trial and of already computed corrections.
-    pub fn report(&self, corrections: &[Correction]) -> TrialReport {
+    pub fn report<'c>(&self, corrections: impl IntoIterator<Item = &'c Correction>) -> TrialReport {
+        let corrections: Vec<&Correction> = corrections.into_iter().collect();
         let t = self.trial;
         TrialReport {
             trial: t.name.clone(),
@@ -142,28 +141,6 @@ impl ReportInput<'_> {
             glitches: glitches(t, DEFAULT_GLITCH_DEG),
             reference: None,
         }
-    }
-
-    /// Runs each variant, then reports.
-    pub fn run(
-        &self,
-        variants: &[Variant],
-        control: &RunControl,
-    ) -> Result<TrialReport, Cancelled> {
-        let corrections = variants
-            .iter()
-            .map(|&v| {
-                correct_trial(
-                    self.trial,
-                    self.model,
-                    self.limits,
-                    self.settings,
-                    v,
-                    control,
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(self.report(&corrections))
     }
 }
 

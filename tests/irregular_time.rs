@@ -3,10 +3,11 @@
 //! read back exactly, with the gap, the borrowing window and the glitch reported.
 
 use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::correct::pipeline::{self, Setup};
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::metrics::trial_figures;
 use acm_workbench::model::Model;
-use acm_workbench::report::{format_text, ReportInput};
+use acm_workbench::report::format_text;
 use acm_workbench::rotation::{angle_between_deg, quat_axis_angle_deg, quat_from_wxyz};
 use acm_workbench::simulate::{simulate, SimConfig};
 use acm_workbench::trial::glitch::{glitches, DEFAULT_GLITCH_DEG};
@@ -216,17 +217,23 @@ fn stream_with_gap_and_glitch_reads_back_and_is_reported() {
     );
 
     // The report says all of it; the glitch stays in the data.
-    let input = ReportInput {
-        trial: &back,
+    let limits = LimitTable::default_table();
+    let settings = Settings::default();
+    let setup = Setup {
         model: &model,
-        limits: &LimitTable::default_table(),
+        limits: &limits,
         limits_source: "table_3_2.csv",
-        settings: &Settings::default(),
-        truth: None,
+        settings: &settings,
     };
-    let r = input
-        .run(&[Variant::Drift], &RunControl::default())
-        .unwrap();
+    let corrections = pipeline::correct_many(
+        &back,
+        setup,
+        &[Variant::Drift],
+        None,
+        &RunControl::default(),
+    )
+    .unwrap();
+    let r = pipeline::report_input(&back, setup, None).report(&corrections);
     let text = format_text(&r);
     assert!(text.contains("time: 1 gap without samples"), "{text}");
     assert!(text.contains("time: irregular sample times"), "{text}");

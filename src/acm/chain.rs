@@ -24,7 +24,7 @@ use super::minimise::{
 };
 use super::window::{correction_series, layout, whole_trial, Window};
 use super::{
-    Cancelled, Correction, HeadingWindow, ImuHeading, JointResult, RunControl, SkippedJoint,
+    Cancelled, Correction, HeadingWindow, ImuHeading, JointResult, Kind, RunControl, SkippedJoint,
     Variant, WindowSolution,
 };
 use crate::baselines;
@@ -54,10 +54,12 @@ pub fn correct_trial(
     variant: Variant,
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
-    match variant {
-        Variant::Ik => crate::ik::correct_trial(trial, model, settings, control),
-        Variant::None => Ok(uncorrected(trial, model, limits, settings)),
-        _ => run(trial, model, limits, settings, variant, None, control),
+    match variant.kind() {
+        Kind::Ik => crate::ik::correct_trial(trial, model, settings, control),
+        Kind::None => Ok(uncorrected(trial, model, limits, settings)),
+        Kind::Acm | Kind::Heading | Kind::Baseline => {
+            run(trial, model, limits, settings, variant, None, control)
+        }
     }
 }
 

@@ -18,148 +18,14 @@ pub mod minimise;
 pub mod parent_cost;
 pub mod window;
 
+pub use crate::run::{Cancelled, RunControl, SkippedJoint, WindowSolution};
+pub use crate::variant::{Kind, Variant};
 pub use chain::{correct_joint, correct_joint_with, correct_trial, recorrect, solve_window};
 
 use crate::limits::Settings;
 use crate::trial::Trial;
 use crate::vertical::Vertical;
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::{AtomicBool, Ordering};
-
-/// The correction variants the engine offers.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    PartialOrd,
-    Ord,
-    Serialize,
-    Deserialize,
-    clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum Variant {
-    /// One correction per joint for the whole trial, no centroid term.
-    Basic,
-    /// Windows + slerp to follow drift, no centroid term (lambda2 = 0).
-    Drift,
-    /// Windows + slerp + the centroid term (lambda2 from the table).
-    DriftCentroid,
-    /// Rivest (2005) for the knees, per drift window; `drift-centroid` elsewhere.
-    Rivest,
-    /// Mueller et al. (2017) axes for the elbows; `drift-centroid` elsewhere.
-    Mueller,
-    /// One constant correction per IMU plus a heading correction about the
-    /// global vertical per window: `G_R' = R_up(-h(t)) G_R C`; no centroid term.
-    DriftHeading,
-    /// As `drift-heading`, with the centroid term.
-    DriftHeadingCentroid,
-    /// IMU inverse kinematics (`crate::ik`): joint coordinates with the
-    /// model's degrees of freedom and hard limits; not the ACM.
-    Ik,
-    /// As `drift-centroid`, with the hinge axes of the model's hinge joints
-    /// estimated in both IMUs' frames ([`hinge`]): they fix two degrees of
-    /// freedom of the distal IMU's correction and of the proximal one's.
-    Hinge,
-    /// No correction: the trial as read, after any pose or functional
-    /// calibration (the step before every other variant).
-    None,
-}
-
-impl Variant {
-    /// Every variant, in the order screens and reports list them.
-    pub const ALL: [Variant; 10] = [
-        Variant::Basic,
-        Variant::Drift,
-        Variant::DriftCentroid,
-        Variant::DriftHeading,
-        Variant::DriftHeadingCentroid,
-        Variant::Rivest,
-        Variant::Mueller,
-        Variant::Ik,
-        Variant::Hinge,
-        Variant::None,
-    ];
-
-    /// The name used on the command line, in files and on screen.
-    pub fn name(self) -> &'static str {
-        match self {
-            Variant::Basic => "basic",
-            Variant::Drift => "drift",
-            Variant::DriftCentroid => "drift-centroid",
-            Variant::Rivest => "rivest",
-            Variant::Mueller => "mueller",
-            Variant::DriftHeading => "drift-heading",
-            Variant::DriftHeadingCentroid => "drift-heading-centroid",
-            Variant::Ik => "ik",
-            Variant::Hinge => "hinge",
-            Variant::None => "none",
-        }
-    }
-
-    /// Parses a variant name.
-    pub fn from_name(name: &str) -> Option<Variant> {
-        Variant::ALL.into_iter().find(|v| v.name() == name)
-    }
-
-    /// Solves per window (true) or once for the whole trial (false).
-    pub fn windowed(self) -> bool {
-        !matches!(self, Variant::Basic | Variant::Ik | Variant::None)
-    }
-
-    /// Uses the table's centroid term.
-    pub fn centroid(self) -> bool {
-        matches!(
-            self,
-            Variant::DriftCentroid
-                | Variant::Rivest
-                | Variant::Mueller
-                | Variant::DriftHeadingCentroid
-                | Variant::Hinge
-        )
-    }
-
-    /// Models drift as a heading rotation about the global vertical.
-    pub fn heading(self) -> bool {
-        matches!(self, Variant::DriftHeading | Variant::DriftHeadingCentroid)
-    }
-
-    /// Estimates the hinge joints' axes and corrects both of their IMUs with them.
-    pub fn hinge(self) -> bool {
-        self == Variant::Hinge
-    }
-}
-
-impl std::fmt::Display for Variant {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// The solution of one window of one joint.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct WindowSolution {
-    /// Window start and end (exclusive), seconds from the first sample.
-    pub start_s: f64,
-    pub end_s: f64,
-    /// Window centre, seconds from the first sample.
-    pub centre_s: f64,
-    /// Samples inside the window.
-    pub samples: usize,
-    /// The correction C (sensor frame of the distal IMU), `[w, x, y, z]`, w >= 0.
-    pub correction: [f64; 4],
-    /// Rotation angle of C, degrees.
-    pub angle_deg: f64,
-    /// Cost at C.
-    pub cost: f64,
-    /// Cost without correction (C = identity).
-    pub cost_uncorrected: f64,
-    /// Cost evaluations spent.
-    pub evaluations: usize,
-}
 
 /// The correction of one joint's distal IMU.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -250,13 +116,6 @@ impl ImuHeading {
     }
 }
 
-/// A joint the engine did not correct, and why.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SkippedJoint {
-    pub joint: String,
-    pub reason: String,
-}
-
 /// A whole-trial correction: the corrected trial plus what was done per joint.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Correction {
@@ -284,25 +143,5 @@ impl Correction {
     /// The estimated heading drift of an IMU (heading-drift variants).
     pub fn heading(&self, imu: &str) -> Option<&ImuHeading> {
         self.headings.iter().find(|h| h.imu == imu)
-    }
-}
-
-/// The run was cancelled before it finished.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[error("correction cancelled")]
-pub struct Cancelled;
-
-/// Progress reporting and cancellation for a long run.
-#[derive(Default, Clone, Copy)]
-pub struct RunControl<'a> {
-    /// Checked before each window; when set, the run stops with [`Cancelled`].
-    pub cancel: Option<&'a AtomicBool>,
-    /// Called with (windows done, windows in all) after each window.
-    pub progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
-}
-
-impl RunControl<'_> {
-    fn cancelled(&self) -> bool {
-        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
     }
 }

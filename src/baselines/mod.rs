@@ -19,8 +19,9 @@ pub mod mueller;
 pub mod rivest;
 
 use crate::acm::window::{between_centres, Window};
-use crate::acm::{Variant, WindowSolution};
 use crate::rotation::{angle_deg, canonical, euler_zyx_deg, quat_from_euler_zyx_deg, wxyz, Quat};
+use crate::run::WindowSolution;
+use crate::variant::Variant;
 use mueller::{
     estimate_axes, rates_from_gyros, rates_from_orientations, MuellerFit, MuellerOptions,
 };

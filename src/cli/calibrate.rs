@@ -4,16 +4,13 @@
 
 use acm_workbench::calibration::simulate::{self, CalibSimConfig, Sloppiness};
 use acm_workbench::calibration::{
-    calibrate, default_output, AppliedCalibration, Calibration, Protocol, Recording,
-    DEFAULT_PROTOCOL_NAME,
+    calibrate, default_output, Calibration, Protocol, Recording, DEFAULT_PROTOCOL_NAME,
 };
-use acm_workbench::model::Model;
 use acm_workbench::rotation::{angle_between_deg, angle_deg, Quat};
-use acm_workbench::trial::Trial;
 use clap::Args;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct CalibrateArgs {
@@ -184,34 +181,6 @@ pub fn format_text(cal: &Calibration, truth: Option<&BTreeMap<String, Quat>>) ->
         let _ = writeln!(out, "skipped {}: {}", s.imu, s.reason);
     }
     out
-}
-
-/// Reads the calibration file `path` (if any) and applies it to `trial`,
-/// printing its warnings unless `quiet`. Returns what the sidecar records.
-pub fn apply(
-    path: Option<&Path>,
-    trial: &mut Trial,
-    model: &Model,
-    quiet: bool,
-) -> anyhow::Result<Option<AppliedCalibration>> {
-    let Some(path) = path else {
-        return Ok(None);
-    };
-    let applied = AppliedCalibration::load(path)?;
-    let warnings = applied.apply(trial, model);
-    if !quiet {
-        eprintln!(
-            "{}: calibration {} applied to {} of its {} IMUs first",
-            trial.name,
-            applied.file,
-            applied.imus.len() - warnings.len(),
-            applied.imus.len()
-        );
-        for w in warnings {
-            eprintln!("warning: {w}");
-        }
-    }
-    Ok(Some(applied))
 }
 
 #[derive(Debug, Args)]

@@ -1,10 +1,13 @@
 //! What several commands share: model, limits and settings resolution, progress.
 
+use acm_workbench::calibration::AppliedCalibration;
+use acm_workbench::correct::pipeline::{self, Preparation, Prepared, Setup, Source};
 use acm_workbench::limits::{LimitTable, LimitsDir, Settings};
 use acm_workbench::model::{Model, SignedAxis};
-use acm_workbench::pose::{calibrate, PoseCalibration, PoseRecord, PoseTime};
+use acm_workbench::pose::{PoseCalibration, PoseTime};
 use acm_workbench::trial::detect_model;
-use acm_workbench::trial::Trial;
+use acm_workbench::variant::{Variant, VARIANTS};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -74,21 +77,39 @@ impl PoseArgs {
     }
 }
 
-/// `trial` pose-calibrated as `calibration` asks (unchanged without one).
-pub fn apply_pose(
-    trial: Trial,
-    model: &Model,
-    calibration: Option<&PoseCalibration>,
-    file: &Path,
-) -> anyhow::Result<(Trial, Option<PoseRecord>)> {
-    match calibration {
-        None => Ok((trial, None)),
-        Some(c) => {
-            let (t, r) = calibrate(&trial, model, c)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
-            Ok((t, Some(r)))
+/// The pipeline's first two steps for the trial at `input`: read it, then
+/// prepare it as `preparation` asks, printing what the functional
+/// calibration did unless `quiet` (`announce`: say that it was applied).
+pub fn load_prepared(
+    ctx: &Context,
+    input: &Path,
+    preparation: &Preparation,
+    announce: bool,
+    quiet: bool,
+) -> anyhow::Result<(Source, Prepared)> {
+    let loaded = pipeline::load(input, &ctx.model)?;
+    let prepared = pipeline::prepare(loaded.trial, ctx.setup(), preparation)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+    if let (Some(c), false) = (&prepared.calibration, quiet) {
+        if announce {
+            eprintln!(
+                "{}: calibration {} applied to {} of its {} IMUs first",
+                prepared.trial.name,
+                c.file,
+                c.imus.len() - prepared.calibration_warnings.len(),
+                c.imus.len()
+            );
+        }
+        for w in &prepared.calibration_warnings {
+            eprintln!("warning: {w}");
         }
     }
+    Ok((loaded.source, prepared))
+}
+
+/// The functional calibration file `path` names, if any.
+pub fn load_calibration(path: Option<&Path>) -> anyhow::Result<Option<AppliedCalibration>> {
+    Ok(path.map(AppliedCalibration::load).transpose()?)
 }
 
 /// Sizes the global worker pool (all cores when `None`). Results do not
@@ -113,9 +134,23 @@ pub struct Context {
 }
 
 impl Context {
+    /// The pipeline's view of this context.
+    pub fn setup(&self) -> Setup<'_> {
+        Setup {
+            model: &self.model,
+            limits: &self.limits,
+            limits_source: &self.limits_source,
+            settings: &self.settings,
+        }
+    }
+
     /// Checks the drift windows suit `trial` (enough samples per window, not
     /// too many windows); `file` names the trial in the error.
-    pub fn check_trial(&self, trial: &Trial, file: &Path) -> anyhow::Result<()> {
+    pub fn check_trial(
+        &self,
+        trial: &acm_workbench::trial::Trial,
+        file: &Path,
+    ) -> anyhow::Result<()> {
         let s = &self.settings;
         acm_workbench::acm::window::check_layout(&trial.time_s, s.window_s, s.hop_s)
             .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))
@@ -169,12 +204,24 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
 pub struct Progress {
     label: String,
     enabled: bool,
+    /// What the steps count (`windows`), or nothing to show percentages only.
+    unit: &'static str,
     last: std::sync::atomic::AtomicUsize,
 }
 
 impl Progress {
     pub fn new(label: &str, quiet: bool) -> Progress {
         Progress {
+            unit: "windows",
+            ..Progress::overall(label, quiet)
+        }
+    }
+
+    /// Progress shown as a percentage of the whole run only (a run over
+    /// several variants counts parts of the whole, not windows).
+    pub fn overall(label: &str, quiet: bool) -> Progress {
+        Progress {
+            unit: "",
             label: label.to_string(),
             enabled: !quiet && std::io::stderr().is_terminal(),
             last: std::sync::atomic::AtomicUsize::new(usize::MAX),
@@ -188,7 +235,10 @@ impl Progress {
         }
         let pct = 100 * done / total;
         if self.last.swap(pct, std::sync::atomic::Ordering::Relaxed) != pct {
-            eprint!("\r{}: {pct:3}% ({done}/{total} windows)", self.label);
+            match self.unit {
+                "" => eprint!("\r{}: {pct:3}%", self.label),
+                unit => eprint!("\r{}: {pct:3}% ({done}/{total} {unit})", self.label),
+            }
         }
     }
 
@@ -198,4 +248,13 @@ impl Progress {
             eprintln!();
         }
     }
+}
+
+/// The parser of `--variant`: the variant table's names, each with its
+/// description in `--help`.
+pub fn variant_parser() -> impl TypedValueParser<Value = Variant> {
+    let names = VARIANTS
+        .iter()
+        .map(|r| PossibleValue::new(r.name).help(r.description));
+    PossibleValuesParser::new(names).map(|s| Variant::from_name(&s).expect("a name of the table"))
 }

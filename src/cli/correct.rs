@@ -1,12 +1,14 @@
 //! `acmw correct`: correct a trial, write the corrected trial and its sidecar.
 
 use super::common::{
-    apply_pose, load_context, set_threads, Context, EngineArgs, PoseArgs, Progress,
+    load_calibration, load_context, load_prepared, set_threads, variant_parser, Context,
+    EngineArgs, PoseArgs, Progress,
 };
-use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::acm::{RunControl, Variant};
+use acm_workbench::correct::pipeline::{self, Preparation};
 use acm_workbench::ik::output::coordinates_path;
-use acm_workbench::sidecar::{default_output, SaveRequest, Sidecar};
-use acm_workbench::trial::{detect_format, read_trial, TrialFormat};
+use acm_workbench::sidecar::Sidecar;
+use acm_workbench::trial::TrialFormat;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -22,7 +24,7 @@ pub struct CorrectArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Correction variant.
-    #[arg(long, value_enum, default_value_t = Variant::DriftCentroid)]
+    #[arg(long, value_parser = variant_parser(), default_value = "drift-centroid")]
     pub variant: Variant,
     /// Output format [default: the input's].
     #[arg(long, value_enum)]
@@ -96,80 +98,40 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             (ctx, args.variant, pose)
         }
     };
-    let (in_format, gzip) = detect_format(&args.input)?;
-    let mut trial = read_trial(&args.input, &ctx.model)?;
-    ctx.check_trial(&trial, &args.input)?;
     let calibration = match recorded_calibration {
-        Some(c) => {
-            for w in c.apply(&mut trial, &ctx.model) {
-                if !args.quiet {
-                    eprintln!("warning: {w}");
-                }
-            }
-            Some(c)
-        }
-        None => super::calibrate::apply(
-            args.calibration.as_deref(),
-            &mut trial,
-            &ctx.model,
-            args.quiet,
-        )?,
+        Some(c) => Some(c),
+        None => load_calibration(args.calibration.as_deref())?,
     };
-    let (mut trial, pose) = apply_pose(trial, &ctx.model, pose.as_ref(), &args.input)?;
-    // Convention checks: mirrored or offset angles against the table.
-    let checks = acm_workbench::pose::convention::check_conventions(
-        &trial,
-        &ctx.model,
-        &ctx.limits,
-        pose.is_some(),
-    );
-    trial.warnings.extend(checks);
+    let announce = args.from_sidecar.is_none();
+    let preparation = Preparation { calibration, pose };
+    let (source, prepared) = load_prepared(&ctx, &args.input, &preparation, announce, args.quiet)?;
+    let trial = &prepared.trial;
     if !args.quiet {
         for w in &trial.warnings {
             eprintln!("warning: {w}");
         }
     }
-    let format = args.format.unwrap_or(in_format.output_default());
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&args.input, variant, format, gzip));
+    let mut output = source.default_output(variant, args.format);
+    if let Some(o) = &args.output {
+        output.path = o.clone();
+    }
+    output.sidecar = args.sidecar.clone();
     let progress = Progress::new(&format!("{} {variant}", trial.name), args.quiet);
     let report = |d: usize, t: usize| progress.update(d, t);
     let control = RunControl {
         cancel: None,
         progress: Some(&report),
     };
-    let correction = correct_trial(
-        &trial,
-        &ctx.model,
-        &ctx.limits,
-        &ctx.settings,
-        variant,
-        &control,
-    )?;
+    let correction = pipeline::correct(trial, ctx.setup(), variant, &control)?;
     progress.finish();
-    if format == TrialFormat::Sto && correction.corrected.has_gyros() {
+    if output.format == TrialFormat::Sto && correction.corrected.has_gyros() {
         eprintln!(
             "warning: .sto has no gyroscope columns: the corrected trial's gyroscope readings are not written (--format quat-csv keeps them)"
         );
     }
-    let request = SaveRequest {
-        input: &args.input,
-        input_format: in_format,
-        trial: &trial,
-        pose: pose.as_ref(),
-        correction: &correction,
-        model: &ctx.model,
-        limits: &ctx.limits,
-        limits_source: &ctx.limits_source,
-        output: &output,
-        output_format: format,
-        sidecar: args.sidecar.as_deref(),
-    };
-    let mut sidecar = request.sidecar()?;
-    sidecar.calibration = calibration;
-    let sc_path = request.save_with(sidecar)?;
+    let sc_path = pipeline::save(&source, &prepared, &correction, ctx.setup(), &output)?;
+    let output = output.path;
+    let pose = &prepared.pose;
     if !args.quiet {
         for s in &correction.skipped {
             eprintln!("skipped {}: {}", s.joint, s.reason);

@@ -32,7 +32,7 @@ pub struct PlotArgs {
     #[arg(long)]
     pub joint: Option<String>,
     /// Correction variant drawn beside the uncorrected angles (`traces`).
-    #[arg(long, value_enum, default_value_t = Variant::DriftCentroid)]
+    #[arg(long, value_parser = super::common::variant_parser(), default_value = "drift-centroid")]
     pub variant: Variant,
     /// Draw the uncorrected angles only (`traces`, `scatter`, `globe`; no correction is run).
     #[arg(long)]

@@ -33,7 +33,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub joint: Option<String>,
     /// Variant to show [default: drift].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::common::variant_parser())]
     pub variant: Option<Variant>,
     /// Size in cells, WxH.
     #[arg(long, default_value = "80x24", value_parser = parse_size)]

@@ -1,10 +1,12 @@
 //! `acmw report`: the figures of docs/method.md section 16 before and after each variant.
 
-use super::common::{apply_pose, load_context, EngineArgs, PoseArgs, Progress};
-use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use super::common::{
+    load_calibration, load_context, load_prepared, EngineArgs, PoseArgs, Progress,
+};
+use acm_workbench::acm::{RunControl, Variant};
+use acm_workbench::correct::pipeline::{self, Preparation};
 use acm_workbench::reference::{compare, read_reference, CompareOptions};
-use acm_workbench::report::{format_text, ReportInput};
-use acm_workbench::trial::read_trial;
+use acm_workbench::report::format_text;
 use acm_workbench::truth::load_truth_beside;
 use clap::Args;
 use std::path::PathBuf;
@@ -18,7 +20,7 @@ pub struct ReportArgs {
     /// one IMU); a folder of such exports; or an OpenSense mapping `.xml` naming them.
     pub input: PathBuf,
     /// Variants to run and compare (repeatable) [default: all].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::common::variant_parser())]
     pub variant: Vec<Variant>,
     /// Flag orientation jumps larger than this between neighbouring samples,
     /// degrees [default: `glitch_deg` in ./joint_limits/settings.toml, else 30].
@@ -86,28 +88,16 @@ fn positive_deg(s: &str) -> Result<f64, String> {
 /// Runs `acmw report`.
 pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     let ctx = load_context(&args.engine, Some(&args.input))?;
-    let mut trial = read_trial(&args.input, &ctx.model)?;
-    ctx.check_trial(&trial, &args.input)?;
-    super::calibrate::apply(
-        args.calibration.as_deref(),
-        &mut trial,
-        &ctx.model,
-        args.quiet,
-    )?;
-    let pose_calibration = args.pose.calibration(&ctx.model);
-    let (mut trial, pose) = apply_pose(trial, &ctx.model, pose_calibration.as_ref(), &args.input)?;
-    // Convention checks: mirrored or offset angles against the table.
-    let checks = acm_workbench::pose::convention::check_conventions(
-        &trial,
-        &ctx.model,
-        &ctx.limits,
-        pose.is_some(),
-    );
-    trial.warnings.extend(checks);
+    let preparation = Preparation {
+        calibration: load_calibration(args.calibration.as_deref())?,
+        pose: args.pose.calibration(&ctx.model),
+    };
+    let (_, prepared) = load_prepared(&ctx, &args.input, &preparation, true, args.quiet)?;
+    let trial = &prepared.trial;
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {
             let t = t?;
-            t.check_against(&trial).map_err(|e| {
+            t.check_against(trial).map_err(|e| {
                 anyhow::anyhow!(
                     "{}: truth does not fit the trial: {e}",
                     args.input.display()
@@ -122,29 +112,23 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     } else {
         args.variant.clone()
     };
-    let progress = Progress::new(&trial.name, args.quiet);
+    let progress = Progress::overall(&trial.name, args.quiet);
     let report = |d: usize, t: usize| progress.update(d, t);
     let control = RunControl {
         cancel: None,
         progress: Some(&report),
     };
-    let input = ReportInput {
-        trial: &trial,
-        model: &ctx.model,
-        limits: &ctx.limits,
-        limits_source: &ctx.limits_source,
-        settings: &ctx.settings,
-        truth: truth.as_ref().map(|t| &t.segments),
-    };
-    let corrections = variants
-        .iter()
-        .map(|&v| correct_trial(&trial, &ctx.model, &ctx.limits, &ctx.settings, v, &control))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut r = input.report(&corrections);
-    r.pose_calibration = pose;
+    let setup = ctx.setup();
+    let corrections = pipeline::correct_many(trial, setup, &variants, None, &control)?;
+    let mut r = pipeline::report(
+        &prepared,
+        setup,
+        truth.as_ref().map(|t| &t.segments),
+        &corrections,
+    );
     if let Some(path) = &args.reference {
         let reference = read_reference(path, &ctx.model)?;
-        let mut series = vec![("uncorrected".to_string(), &trial)];
+        let mut series = vec![("uncorrected".to_string(), trial)];
         series.extend(
             corrections
                 .iter()
@@ -163,7 +147,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
     }
     let glitch_deg = args.glitch_deg.unwrap_or(ctx.glitch_deg);
     if glitch_deg != r.glitch_deg {
-        r.set_glitch_threshold(&trial, glitch_deg);
+        r.set_glitch_threshold(trial, glitch_deg);
     }
     progress.finish();
     if args.json {

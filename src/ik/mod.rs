@@ -16,11 +16,13 @@ pub mod solver;
 pub use skeleton::{Coordinate, Skeleton};
 pub use solver::{Pose, Solver, SolverOptions};
 
-use crate::acm::{Cancelled, Correction, RunControl, SkippedJoint, Variant};
+use crate::acm::Correction;
 use crate::limits::Settings;
 use crate::model::Model;
 use crate::rotation::Quat;
+use crate::run::{Cancelled, RunControl, SkippedJoint};
 use crate::trial::{ImuSeries, Trial};
+use crate::variant::Variant;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;

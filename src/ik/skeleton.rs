@@ -7,8 +7,8 @@
 //! and its `default_pose_deg` value otherwise. Coordinates are radians inside
 //! the solver, degrees in every output.
 
-use crate::acm::SkippedJoint;
 use crate::model::{Axis, Model};
+use crate::run::SkippedJoint;
 
 /// One joint coordinate: an Euler axis of a joint that moves.
 #[derive(Debug, Clone, PartialEq)]

@@ -9,12 +9,12 @@ pub mod pose;
 use super::app::{update, App};
 use super::msg::{Effect, Msg, RunJob};
 use super::workbench::{LimitsState, Loaded, SavedOutput};
-use crate::acm::{correct_trial, recorrect, Correction, RunControl, Variant};
+use crate::acm::{Correction, RunControl, Variant};
+use crate::correct::pipeline::{self, Recorrect, Setup, Source};
 use crate::limits::{LimitTable, LimitsDir, SettingsFile};
 use crate::metrics::trial_figures;
 use crate::model::Model;
-use crate::report::ReportInput;
-use crate::sidecar::{default_output, SaveRequest};
+use crate::sidecar::default_output;
 use crate::trial::glitch::glitches;
 use crate::trial::xsens_trial::{is_mapping_file, resolve};
 use crate::trial::{detect_format, detect_model, is_trial_path, read_trial, TrialError};
@@ -187,52 +187,41 @@ pub fn saved_outputs(
 /// Corrects a trial with every variant (or re-corrects the edited joints).
 pub fn run_job(job: &RunJob, cancel: &AtomicBool, progress: &(dyn Fn(u8) + Sync)) -> Msg {
     let l = &job.loaded;
-    let n = Variant::ALL.len();
     let result = (|| {
-        let s = &job.settings;
-        crate::acm::window::check_layout(&l.trial.time_s, s.window_s, s.hop_s)?;
-        let mut out: Vec<Arc<Correction>> = Vec::with_capacity(n);
-        for (k, v) in Variant::ALL.into_iter().enumerate() {
-            let report = move |done: usize, total: usize| {
-                let frac = if total == 0 {
-                    1.0
-                } else {
-                    done as f64 / total as f64
-                };
-                progress(((k as f64 + frac) * 100.0 / n as f64) as u8);
-            };
-            let control = RunControl {
-                cancel: Some(cancel),
-                progress: Some(&report),
-            };
-            let c = match &job.recorrect {
-                Some((previous, joints)) => {
-                    let names: Vec<&str> = joints.iter().map(String::as_str).collect();
-                    recorrect(
-                        &l.trial,
-                        &l.model,
-                        &job.limits,
-                        &job.settings,
-                        &previous[k],
-                        &names,
-                        &control,
-                    )
-                }
-                None => correct_trial(&l.trial, &l.model, &job.limits, &job.settings, v, &control),
-            }
-            .map_err(|e| e.to_string())?;
-            out.push(Arc::new(c));
-        }
-        let input = ReportInput {
-            trial: &l.trial,
+        let setup = Setup {
             model: &l.model,
             limits: &job.limits,
             limits_source: &job.limits_source,
             settings: &job.settings,
-            truth: l.truth.as_ref(),
         };
-        let corrections: Vec<Correction> = out.iter().map(|c| (**c).clone()).collect();
-        let report = input.report(&corrections);
+        let s = &job.settings;
+        crate::acm::window::check_layout(&l.trial.time_s, s.window_s, s.hop_s)?;
+        let report = |done: usize, total: usize| progress((done * 100 / total.max(1)) as u8);
+        let control = RunControl {
+            cancel: Some(cancel),
+            progress: Some(&report),
+        };
+        let previous: Vec<&Correction>;
+        let joints: Vec<&str>;
+        let recorrect = match &job.recorrect {
+            Some((p, j)) => {
+                previous = p.iter().map(|c| &**c).collect();
+                joints = j.iter().map(String::as_str).collect();
+                Some(Recorrect {
+                    previous: &previous,
+                    joints: &joints,
+                })
+            }
+            None => None,
+        };
+        let out: Vec<Arc<Correction>> =
+            pipeline::correct_many(&l.trial, setup, &Variant::ALL, recorrect, &control)
+                .map_err(|e| e.to_string())?
+                .into_iter()
+                .map(Arc::new)
+                .collect();
+        let report = pipeline::report_input(&l.trial, setup, l.truth.as_ref())
+            .report(out.iter().map(|c| &**c));
         Ok((out, report))
     })();
     Msg::RunDone {
@@ -242,7 +231,6 @@ pub fn run_job(job: &RunJob, cancel: &AtomicBool, progress: &(dyn Fn(u8) + Sync)
     }
 }
 
-/// Saves a corrected trial and its sidecar at the default output path.
 pub fn save_variant(
     dir: &Path,
     file: &str,
@@ -252,40 +240,42 @@ pub fn save_variant(
     limits: &LimitTable,
     limits_source: &str,
 ) -> Msg {
-    let output = default_output(
-        path,
-        correction.variant,
-        loaded.format.output_default(),
-        loaded.gzip,
-    );
-    let req = SaveRequest {
-        input: path,
-        input_format: loaded.format,
-        trial: &loaded.trial,
-        pose: loaded.pose.as_ref(),
-        correction,
+    let source = Source {
+        path: path.to_path_buf(),
+        format: loaded.format,
+        gzip: loaded.gzip,
+    };
+    let output = source.default_output(correction.variant, None);
+    let settings = correction.settings;
+    let setup = Setup {
         model: &loaded.model,
         limits,
         limits_source,
-        output: &output,
-        output_format: loaded.format.output_default(),
-        sidecar: None,
+        settings: &settings,
     };
     let shown = output
+        .path
         .strip_prefix(dir)
         .map(Path::to_path_buf)
-        .unwrap_or_else(|_| output.clone());
+        .unwrap_or_else(|_| output.path.clone());
+    let saved = pipeline::save_trial(
+        &source,
+        &loaded.trial,
+        loaded.pose.as_ref(),
+        correction,
+        setup,
+        &output,
+        None,
+    );
     Msg::Saved {
         file: file.to_string(),
         variant: correction.variant,
-        result: req
-            .save()
+        result: saved
             .map(|_| shown.display().to_string())
             .map_err(|e| format!("{e:#}")),
     }
 }
 
-/// Saves the table and settings in `dir` (created if missing).
 pub fn save_limits(dir: &Path, table_name: &str, table_csv: &str, settings_toml: &str) -> Msg {
     let result = (|| {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;

@@ -22,10 +22,7 @@ fn rms(f: &JointFigures) -> Option<f64> {
 /// A variant's name in a 14-character column (the status list below the
 /// table spells every name out).
 fn column_label(v: Variant) -> &'static str {
-    match v {
-        Variant::DriftHeadingCentroid => "drift-hdg-cent",
-        v => v.name(),
-    }
+    v.info().column
 }
 
 pub fn render(col: usize, app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {

@@ -14,13 +14,7 @@ use ratatui::Frame;
 
 /// A variant's name in a 7-character column.
 fn short_name(v: Variant) -> &'static str {
-    match v {
-        Variant::DriftCentroid => "d+c",
-        Variant::Mueller => "muell",
-        Variant::DriftHeading => "d+h",
-        Variant::DriftHeadingCentroid => "d+h+c",
-        v => v.name(),
-    }
+    v.info().short
 }
 
 /// The name column's header: the filter first while there is one, so it
