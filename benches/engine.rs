@@ -7,7 +7,8 @@
 //! as a multiple of the decoded orientation data (samples x IMUs x 32 bytes).
 
 use acm_workbench::acm::window::layout;
-use acm_workbench::acm::{correct_joint, correct_trial, RunControl, Variant};
+use acm_workbench::acm::{correct_joint, RunControl, Variant};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::Quat;

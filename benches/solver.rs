@@ -13,7 +13,8 @@
 //! from the mean time per iteration of criterion's own samples.
 
 use acm_workbench::acm::minimise::Solver;
-use acm_workbench::acm::{correct_trial, recorrect, Correction, RunControl, Variant};
+use acm_workbench::acm::{Correction, RunControl, Variant};
+use acm_workbench::correct::{correct_trial, recorrect};
 use acm_workbench::limits::{LimitRow, LimitTable, Settings};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::Quat;

@@ -24,7 +24,7 @@ pub mod save;
 pub mod sidecar;
 pub mod simulate;
 pub mod trial;
-pub mod truth;
 pub mod ui;
 pub mod variant;
 pub mod vertical;
+pub mod window;

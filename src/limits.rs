@@ -14,7 +14,6 @@
 //! the joint's three rows. The global settings (`lambda1`, window and hop) live in
 //! `joint_limits/settings.toml` (see [`Settings`]).
 
-use crate::acm::minimise::Solver;
 use crate::model::Model;
 use crate::vertical::Vertical;
 use serde::{Deserialize, Serialize};
@@ -644,6 +643,27 @@ fn key_line(text: &str, key: &str) -> u64 {
                 .is_some_and(|rest| rest.trim_start().starts_with('='))
         })
         .map_or(1, |i| i as u64 + 1)
+}
+
+/// Which minimiser solves the ACM's window costs.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Solver {
+    /// Value and gradient in one pass, quasi-Newton steps ([`crate::acm::minimise::minimise_shaped`]).
+    #[default]
+    Gradient,
+    /// Nelder-Mead with restarts on values only ([`crate::acm::minimise::minimise`]): the previous
+    /// solver, kept as the reference.
+    NelderMead,
+}
+
+impl Solver {
+    /// True for the default solver (settings files leave it out).
+    pub fn is_default(&self) -> bool {
+        *self == Solver::default()
+    }
 }
 
 #[cfg(test)]

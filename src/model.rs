@@ -469,7 +469,7 @@ impl Model {
         let model: Model = toml::from_str(text).map_err(|e| {
             let (line, column) = e
                 .span()
-                .map(|sp| crate::calibration::error::line_col(text, sp.start))
+                .map(|sp| crate::input::line_col(text, sp.start))
                 .unwrap_or((0, 0));
             ModelError::Parse {
                 path: origin.to_string(),

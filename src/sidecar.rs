@@ -12,7 +12,6 @@ use crate::pose::PoseRecord;
 use crate::save::{atomic_write, OutputLock};
 use crate::trial::{write_trial, Trial, TrialFormat};
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 /// The limit table a correction used: where from, its content and hash.
@@ -87,13 +86,7 @@ pub struct IkRecord {
     pub summary: IkSummary,
 }
 
-/// Hex SHA-256 of bytes.
-pub fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
+pub use crate::input::sha256_hex;
 
 /// The sidecar path of an output trial: `<output>.acmw.json`.
 pub fn sidecar_path(output: &Path) -> PathBuf {

@@ -6,9 +6,10 @@
 //! corrects the ab/adduction (Z) and rotation (X) of the Z-Y-X angles and keeps
 //! flexion (Y) as measured; the ACM corrects the calf IMU only.
 
-use acm_workbench::acm::{correct_trial, Correction, RunControl, Variant};
+use acm_workbench::acm::{Correction, RunControl, Variant};
 use acm_workbench::baselines::mueller::angle_between_axes_deg;
 use acm_workbench::baselines::BaselineRecord;
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::metrics::joint_angles;
 use acm_workbench::model::Model;

@@ -5,7 +5,8 @@
 //! of excursion and 2 deg of flexion range are the acceptance figures. The
 //! full-body figures compare variants on the same data, so noise cancels out.
 
-use acm_workbench::acm::{correct_trial, Correction, RunControl, Variant};
+use acm_workbench::acm::{Correction, RunControl, Variant};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::metrics::{excursion_figures, joint_angles, truth_figures};
 use acm_workbench::model::Model;

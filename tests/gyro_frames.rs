@@ -4,8 +4,9 @@
 //! frame. Checked against central differences of the new orientations on a
 //! noise-free simulated body whose gyros are exact.
 
-use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::baselines::{BaselineRecord, RateSource};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::{Model, PoseSetup};
 use acm_workbench::pose::{calibrate, PoseCalibration};

@@ -13,7 +13,8 @@
 //! `full_body_drift` trial and on a second body. Both variants of a pair see
 //! the same data, so noise cancels out of the comparison.
 
-use acm_workbench::acm::{correct_trial, Correction, RunControl, Variant};
+use acm_workbench::acm::{Correction, RunControl, Variant};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::metrics::{joint_angles, truth_figures};
 use acm_workbench::model::Model;

@@ -10,8 +10,9 @@
 
 mod common;
 
-use acm_workbench::acm::{correct_trial, Correction, RunControl, Variant};
+use acm_workbench::acm::{Correction, RunControl, Variant};
 use acm_workbench::baselines::mueller::angle_between_axes_deg;
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::{angle_between_deg, Quat};

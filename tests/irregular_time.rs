@@ -2,7 +2,8 @@
 //! the same motion sampled regularly, and a stream with a gap and a glitch is
 //! read back exactly, with the gap, the borrowing window and the glitch reported.
 
-use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::acm::{RunControl, Variant};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::correct::pipeline::{self, Setup};
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::metrics::trial_figures;

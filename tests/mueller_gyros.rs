@@ -4,9 +4,10 @@
 //! thinned, irregular one with a gap, where central differences of the
 //! orientations are coarse and gyros are not.
 
-use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::baselines::mueller::angle_between_axes_deg;
 use acm_workbench::baselines::{BaselineRecord, RateSource};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::metrics::joint_angles;
 use acm_workbench::model::Model;

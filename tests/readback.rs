@@ -5,7 +5,8 @@
 //! model (random misalignment, noise, a heading drift on one IMU, gyros), in
 //! every output format the variant can be written in.
 
-use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::acm::{RunControl, Variant};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::metrics::{joint_angles, trial_figures};
 use acm_workbench::model::{Model, BUILTIN_MODELS};

@@ -3,7 +3,8 @@
 //! change either: checked for three angles and the windowed variants, to
 //! 1e-4 deg on every sample of every joint of the 5-minute drifting trial.
 
-use acm_workbench::acm::{correct_trial, Correction, RunControl, Variant};
+use acm_workbench::acm::{Correction, RunControl, Variant};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::{euler_zyx_deg, quat_axis_angle_deg, wrap180};

@@ -4,8 +4,8 @@
 use acm_workbench::model::Model;
 use acm_workbench::rotation::angle_between_deg;
 use acm_workbench::simulate::simulate;
+use acm_workbench::simulate::truth::load_truth_beside;
 use acm_workbench::trial::read_trial;
-use acm_workbench::truth::load_truth_beside;
 use std::path::Path;
 
 #[test]

@@ -6,7 +6,8 @@
 
 use acm_workbench::acm::minimise::Solver;
 use acm_workbench::acm::window::{layout, whole_trial};
-use acm_workbench::acm::{correct_joint_with, correct_trial, RunControl, Variant};
+use acm_workbench::acm::{correct_joint_with, RunControl, Variant};
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::Quat;

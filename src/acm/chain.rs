@@ -24,7 +24,7 @@ use super::minimise::{
 };
 use super::window::{correction_series, layout, whole_trial, Window};
 use super::{
-    Cancelled, Correction, HeadingWindow, ImuHeading, JointResult, Kind, RunControl, SkippedJoint,
+    Cancelled, Correction, HeadingWindow, ImuHeading, JointResult, RunControl, SkippedJoint,
     Variant, WindowSolution,
 };
 use crate::baselines;
@@ -45,8 +45,9 @@ pub struct JointSolution {
     pub series: Vec<Quat>,
 }
 
-/// Corrects every joint of `model` present in `trial` with `variant`.
-pub fn correct_trial(
+/// Corrects every joint of `model` present in `trial` with `variant`, down
+/// the chain: the solver of the ACM, heading and baseline kinds.
+pub fn correct_chain(
     trial: &Trial,
     model: &Model,
     limits: &LimitTable,
@@ -54,18 +55,12 @@ pub fn correct_trial(
     variant: Variant,
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
-    match variant.kind() {
-        Kind::Ik => crate::ik::correct_trial(trial, model, settings, control),
-        Kind::None => Ok(uncorrected(trial, model, limits, settings)),
-        Kind::Acm | Kind::Heading | Kind::Baseline => {
-            run(trial, model, limits, settings, variant, None, control)
-        }
-    }
+    run(trial, model, limits, settings, variant, None, control)
 }
 
 /// The `none` variant: the trial as it is, every joint left uncorrected (the
 /// joints that could not be corrected in any variant are listed as skipped).
-fn uncorrected(
+pub fn uncorrected(
     trial: &Trial,
     model: &Model,
     limits: &LimitTable,
@@ -95,8 +90,8 @@ fn uncorrected(
 /// for the rest (after a limit edit, say). For the heading variants the joint
 /// above each named one is redone too, with everything below it: its IMU's fit
 /// looks ahead at the named joint's limits ([`super::lookahead`]). `previous`
-/// must come from the same trial, model and variant.
-pub fn recorrect(
+/// must come from the same trial, model and variant, one of the chain's kinds.
+pub fn recorrect_chain(
     trial: &Trial,
     model: &Model,
     limits: &LimitTable,
@@ -105,11 +100,6 @@ pub fn recorrect(
     joints: &[&str],
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
-    if matches!(previous.variant, Variant::Ik | Variant::None) {
-        // Inverse kinematics and no correction do not read the limit table
-        // or the settings.
-        return Ok(previous.clone());
-    }
     let mut redo = BTreeSet::new();
     for (k, j) in model.joints.iter().enumerate() {
         if joints.contains(&j.name.as_str()) {
@@ -839,7 +829,7 @@ mod tests {
             .build()
             .unwrap()
             .install(|| {
-                correct_trial(
+                correct_chain(
                     trial,
                     model,
                     table,
@@ -909,7 +899,7 @@ mod tests {
         previous: &Correction,
     ) -> Correction {
         let settings = Settings::default();
-        recorrect(
+        recorrect_chain(
             trial,
             model,
             table,
@@ -997,7 +987,7 @@ mod tests {
             cancel: Some(&cancel),
             progress: None,
         };
-        let r = correct_trial(
+        let r = correct_chain(
             &trial,
             &model,
             &table,

@@ -19,28 +19,8 @@
 
 use crate::rotation::{angle_deg, quat_from_rotvec, Quat};
 use nalgebra::{Matrix3, Vector3};
-use serde::{Deserialize, Serialize};
 
-/// Which minimiser solves the ACM's window costs.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum Solver {
-    /// Value and gradient in one pass, quasi-Newton steps ([`minimise_shaped`]).
-    #[default]
-    Gradient,
-    /// Nelder-Mead with restarts on values only ([`minimise`]): the previous
-    /// solver, kept as the reference.
-    NelderMead,
-}
-
-impl Solver {
-    /// True for the default solver (settings files leave it out).
-    pub fn is_default(&self) -> bool {
-        *self == Solver::default()
-    }
-}
+pub use crate::limits::Solver;
 
 /// Tuning of the minimiser.
 #[derive(Debug, Clone, Copy, PartialEq)]

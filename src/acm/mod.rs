@@ -16,11 +16,14 @@ pub mod hinge;
 pub mod lookahead;
 pub mod minimise;
 pub mod parent_cost;
-pub mod window;
+/// The window layout, shared with the baselines (a leaf: [`crate::window`]).
+pub use crate::window;
 
 pub use crate::run::{Cancelled, RunControl, SkippedJoint, WindowSolution};
 pub use crate::variant::{Kind, Variant};
-pub use chain::{correct_joint, correct_joint_with, correct_trial, recorrect, solve_window};
+pub use chain::{
+    correct_chain, correct_joint, correct_joint_with, recorrect_chain, solve_window, uncorrected,
+};
 
 use crate::limits::Settings;
 use crate::trial::Trial;

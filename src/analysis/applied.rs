@@ -91,7 +91,8 @@ impl AppliedCorrection {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acm::{correct_trial, RunControl, Variant};
+    use crate::acm::{RunControl, Variant};
+    use crate::correct::correct_trial;
     use crate::limits::{LimitTable, Settings};
     use crate::model::Model;
     use crate::rotation::{angle_between_deg, quat_axis_angle_deg};

@@ -18,10 +18,10 @@
 pub mod mueller;
 pub mod rivest;
 
-use crate::acm::window::{between_centres, Window};
 use crate::rotation::{angle_deg, canonical, euler_zyx_deg, quat_from_euler_zyx_deg, wxyz, Quat};
 use crate::run::WindowSolution;
 use crate::variant::Variant;
+use crate::window::{between_centres, Window};
 use mueller::{
     estimate_axes, rates_from_gyros, rates_from_orientations, MuellerFit, MuellerOptions,
 };
@@ -279,8 +279,8 @@ fn mean_rotation(qs: &[Quat]) -> Quat {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acm::window::{layout, whole_trial};
     use crate::rotation::quat_axis_angle_deg;
+    use crate::window::{layout, whole_trial};
 
     #[test]
     fn mueller_records_say_where_the_rates_came_from_and_old_ones_still_load() {

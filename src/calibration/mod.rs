@@ -349,7 +349,7 @@ impl Calibration {
     pub fn applied(&self, file: &str, text: &str) -> AppliedCalibration {
         AppliedCalibration {
             file: file.to_string(),
-            sha256: crate::sidecar::sha256_hex(text.as_bytes()),
+            sha256: crate::input::sha256_hex(text.as_bytes()),
             text: text.to_string(),
             protocol: self.protocol.clone(),
             imus: self

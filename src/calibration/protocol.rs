@@ -271,7 +271,7 @@ impl Protocol {
 
     /// SHA-256 of the protocol's text.
     pub fn sha256(&self) -> String {
-        crate::sidecar::sha256_hex(self.text.as_bytes())
+        crate::input::sha256_hex(self.text.as_bytes())
     }
 }
 

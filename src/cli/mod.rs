@@ -30,7 +30,6 @@ mod calibrate;
 mod common;
 mod correct;
 mod plot;
-mod plot_views;
 mod render;
 mod report;
 mod simulate;

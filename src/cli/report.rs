@@ -7,7 +7,7 @@ use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation};
 use acm_workbench::reference::{compare, read_reference, CompareOptions};
 use acm_workbench::report::format_text;
-use acm_workbench::truth::load_truth_beside;
+use acm_workbench::simulate::truth::load_truth_beside;
 use clap::Args;
 use std::path::PathBuf;
 

@@ -1,10 +1,10 @@
 //! `acmw simulate`: write a simulated trial and its truth beside it.
 
+use acm_workbench::simulate::truth::{self, Truth};
 use acm_workbench::simulate::{
     self, HeadingDrift, ImuMisalignment, KneeAxis, KneeImu, Misalignment, SensorSlip, SimConfig,
     RANDOM_MISALIGNMENT_DEG,
 };
-use acm_workbench::truth::{self, Truth};
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
@@ -436,7 +436,8 @@ mod tests {
         assert!(out.exists());
         assert!(dir.path().join("k.truth.csv.gz").exists());
         let json = std::fs::read_to_string(dir.path().join("k.truth.json")).unwrap();
-        let meta = acm_workbench::truth::TruthMeta::from_json(&json, "k.truth.json").unwrap();
+        let meta =
+            acm_workbench::simulate::truth::TruthMeta::from_json(&json, "k.truth.json").unwrap();
         assert_eq!(meta.config.duration_s, 2.0);
         assert_eq!(meta.config.gyro, None);
         assert!(!json.contains("gyro"), "{json}");
@@ -475,7 +476,8 @@ mod tests {
             .iter()
             .all(|s| s.gyro.as_ref().map(Vec::len) == Some(150)));
         let json = std::fs::read_to_string(dir.path().join("e.truth.json")).unwrap();
-        let meta = acm_workbench::truth::TruthMeta::from_json(&json, "e.truth.json").unwrap();
+        let meta =
+            acm_workbench::simulate::truth::TruthMeta::from_json(&json, "e.truth.json").unwrap();
         assert_eq!(meta.config.gyro.map(|g| g.noise_deg_s), Some(0.5));
         // The noise needs --gyro.
         let argv = [

@@ -36,8 +36,9 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
-use crate::acm::{correct_trial, recorrect, Cancelled, Correction, RunControl, Variant};
+use crate::acm::{Cancelled, Correction, RunControl, Variant};
 use crate::calibration::AppliedCalibration;
+use crate::correct::{correct_trial, recorrect};
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
 use crate::pose::convention::check_conventions;

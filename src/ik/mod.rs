@@ -16,16 +16,12 @@ pub mod solver;
 pub use skeleton::{Coordinate, Skeleton};
 pub use solver::{Pose, Solver, SolverOptions};
 
-use crate::acm::Correction;
-use crate::limits::Settings;
 use crate::model::Model;
 use crate::rotation::Quat;
 use crate::run::{Cancelled, RunControl, SkippedJoint};
 use crate::trial::{ImuSeries, Trial};
-use crate::variant::Variant;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::Ordering;
-use std::sync::Arc;
 
 /// Frames between progress reports and cancellation checks.
 const PROGRESS_FRAMES: usize = 500;
@@ -198,52 +194,6 @@ fn wrap_unlimited(sk: &Skeleton, q: &mut [f64]) {
             *v = (*v + PI).rem_euclid(TAU) - PI;
         }
     }
-}
-
-/// The `ik` variant: the trial with every IMU of the tree replaced by the
-/// segment orientation the solved coordinates imply. IMUs outside the tree
-/// are left as they are.
-pub fn correct_trial(
-    trial: &Trial,
-    model: &Model,
-    settings: &Settings,
-    control: &RunControl,
-) -> Result<Correction, Cancelled> {
-    let solved = solve_trial(trial, model, &SolverOptions::default(), control)?;
-    let mut corrected = trial.clone();
-    let (ik, skipped) = match solved {
-        Some(IkSolution { run, segments }) => {
-            for s in segments {
-                // Segment orientations, not sensor ones: the sensor-frame
-                // gyros no longer describe them and are dropped.
-                let imu = corrected.imu_mut(&s.name).expect("present");
-                imu.orientation = s.orientation;
-                imu.gyro = None;
-            }
-            let skipped = run.skipped.clone();
-            (Some(Arc::new(run)), skipped)
-        }
-        None => (
-            None,
-            model
-                .joints
-                .iter()
-                .map(|j| SkippedJoint {
-                    joint: j.name.clone(),
-                    reason: format!("the base IMU '{}' is not in the trial", model.base),
-                })
-                .collect(),
-        ),
-    };
-    Ok(Correction {
-        variant: Variant::Ik,
-        settings: *settings,
-        corrected,
-        joints: vec![],
-        skipped,
-        headings: vec![],
-        ik,
-    })
 }
 
 #[cfg(test)]

@@ -1,10 +1,24 @@
 use super::output::{coordinates_csv, coordinates_path};
 use super::sim::{simulate, IkSimConfig};
 use super::*;
+use crate::acm::Correction;
+use crate::limits::{LimitTable, Settings};
 use crate::metrics::joint_angles;
 use crate::model::{Axis, HardLimits};
 use crate::rotation::{angle_between_deg, quat_from_euler_zyx_deg, wrap180};
+use crate::variant::Variant;
 use std::path::Path;
+
+/// The `ik` variant through the engine's dispatch.
+fn correct_trial(
+    trial: &Trial,
+    model: &Model,
+    settings: &Settings,
+    control: &RunControl,
+) -> Result<Correction, Cancelled> {
+    let limits = LimitTable::default_table();
+    crate::correct::correct_trial(trial, model, &limits, settings, Variant::Ik, control)
+}
 
 fn run(trial: &Trial, model: &Model) -> IkSolution {
     solve_trial(

@@ -1,5 +1,6 @@
 use super::*;
-use crate::acm::{correct_trial, RunControl, Variant};
+use crate::acm::{RunControl, Variant};
+use crate::correct::correct_trial;
 use crate::limits::{LimitTable, Settings};
 use crate::metrics::joint_angles;
 use crate::rotation::{angle_between_deg, quat_from_wxyz, wrap180};

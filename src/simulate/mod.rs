@@ -29,7 +29,6 @@ use crate::limits::LimitTable;
 use crate::model::Model;
 use crate::rotation::{self, Quat};
 use crate::trial::{ImuSeries, Trial};
-use crate::truth::{Truth, TruthMeta};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -37,6 +36,7 @@ use rand_distr::{Distribution, Normal, UnitSphere};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
+use truth::{Truth, TruthMeta};
 
 mod elbow;
 pub mod gyro;
@@ -44,6 +44,7 @@ mod motion;
 pub mod swing;
 #[cfg(test)]
 mod tests;
+pub mod truth;
 
 /// The body model every simulation uses.
 pub const MODEL: &str = "infant13";

@@ -2,8 +2,8 @@
 //! globographic plot of one joint, uncorrected beside corrected
 //! (`acm_workbench::plot::{scatter, globe}`).
 
-use super::common::Context;
-use super::plot::{joint_series, PlotArgs};
+use super::{joint_series, PlotArgs};
+use crate::cli::common::Context;
 use acm_workbench::analysis::globe::JointAxes;
 use acm_workbench::analysis::scatter::Colouring;
 use acm_workbench::plot::{self, globe::Globe, scatter::Scatter};

@@ -2,11 +2,14 @@
 //! dispatch stays small: each kind has its own function building its figure
 //! from the library (`acm_workbench::plot`).
 
+mod views;
+
 use super::analysis::{load_trials, pooled, SpanArgs, TableArgs};
 use super::common::{set_threads, Context};
-use acm_workbench::acm::{correct_trial, RunControl, Variant};
+use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::analysis::histogram::{joint_histogram, DEFAULT_BIN_DEG};
 use acm_workbench::analysis::TimeSpan;
+use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::Settings;
 use acm_workbench::metrics::joint_angles;
 use acm_workbench::plot::{self, histogram::Histograms, traces::Traces, PlotKind};
@@ -62,8 +65,8 @@ pub fn run(a: PlotArgs) -> anyhow::Result<i32> {
     match a.kind {
         PlotKind::Traces => traces(&a, &ctx, &trials[0], size)?,
         PlotKind::Histogram => histogram(&a, &ctx, &trials, size)?,
-        PlotKind::Scatter => super::plot_views::scatter(&a, &ctx, &trials[0], size)?,
-        PlotKind::Globe => super::plot_views::globe(&a, &ctx, &trials[0], size)?,
+        PlotKind::Scatter => views::scatter(&a, &ctx, &trials[0], size)?,
+        PlotKind::Globe => views::globe(&a, &ctx, &trials[0], size)?,
     }
     outln!("wrote {}", a.output.display())?;
     Ok(super::EXIT_OK)
