@@ -12,6 +12,7 @@ pub mod analysis;
 pub mod baselines;
 pub mod calibration;
 pub mod correct;
+pub mod file_names;
 pub mod ik;
 pub mod input;
 pub mod limits;

@@ -130,10 +130,10 @@ pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
 /// True when `path`'s name is a trial file: it ends in `.csv`, `.sto`, `.csv.gz` or
 /// `.sto.gz` and is not a truth file (`*.truth.csv`, `*.truth.sto`, optionally `.gz`).
 /// Sidecars (`.json`), backups (`.bak`), temporary files and calibration
-/// recordings (`*.calib.csv`, see [`crate::calibration::is_calibration_recording`])
+/// recordings (`*.calib.csv`, see [`crate::file_names::is_calibration_recording`])
 /// never qualify.
 pub fn is_trial_file(path: &Path) -> bool {
-    if crate::calibration::is_calibration_recording(path) {
+    if crate::file_names::is_calibration_recording(path) {
         return false;
     }
     let Some(name) = path.file_name() else {
