@@ -75,8 +75,9 @@ pub fn check_conventions(
             let [lo, hi] = lim.range_deg[k];
             let mut v: Vec<f64> = angles.iter().map(|a| a[k]).collect();
             let n = v.len() as f64;
-            let below = v.iter().filter(|&&x| x < lo).count() as f64 / n;
-            let above = v.iter().filter(|&&x| x > hi).count() as f64 / n;
+            // Within 1e-9 deg of a limit is on it (rounding of a joint held there).
+            let below = v.iter().filter(|&&x| x < lo - 1e-9).count() as f64 / n;
+            let above = v.iter().filter(|&&x| x > hi + 1e-9).count() as f64 / n;
             let (p2, p98) = (percentile(&mut v, 0.02), percentile(&mut v, 0.98));
             reach[k] = [(-p2).max(0.0), p98.max(0.0)];
             let name = format!("{} {}", joint.name, axis.name());
