@@ -29,6 +29,9 @@ use std::collections::BTreeMap;
 
 type V = Vector3<f64>;
 
+/// A joint that moves: its name, the pose-frame axis and the angle (degrees) over time.
+type Moving<'a> = (&'a str, V, &'a dyn Fn(f64) -> f64);
+
 /// The calibration pose of a model, in the frame the calibration gives the
 /// segments (forward = +x after the heading correction, up = +z).
 struct PoseGeometry {
@@ -158,7 +161,7 @@ fn mountings(model: &Model, rng: &mut ChaCha8Rng) -> BTreeMap<String, Quat> {
 /// sensors on their segments by `mount`, the subject facing `heading_deg`.
 fn physical_trial(
     model: &Model,
-    moving: &[(&str, V, &dyn Fn(f64) -> f64)],
+    moving: &[Moving],
     mount: &BTreeMap<String, Quat>,
     heading_deg: f64,
 ) -> Trial {
@@ -270,7 +273,7 @@ fn gait_passes_the_convention_check_and_a_mirrored_hip_is_named() {
             let mv = standing_movements(joint);
             mv[1].axis
         };
-        let gait: Vec<(&str, V, &dyn Fn(f64) -> f64)> = vec![
+        let gait: Vec<Moving> = vec![
             ("l_hip", flexion("l_hip"), &hip),
             ("r_hip", flexion("r_hip"), &hip),
             ("l_knee", flexion("l_knee"), &knee),
@@ -314,7 +317,7 @@ fn every_variant_reports_flexion_positive() {
     let hip = |t: f64| swing(t, 40.0) - 10.0;
     let knee = |t: f64| swing(t, 60.0);
     let flexion = |j: &str| standing_movements(model.joint(j).unwrap())[1].axis;
-    let gait: Vec<(&str, V, &dyn Fn(f64) -> f64)> = vec![
+    let gait: Vec<Moving> = vec![
         ("l_hip", flexion("l_hip"), &hip),
         ("r_hip", flexion("r_hip"), &hip),
         ("l_knee", flexion("l_knee"), &knee),
