@@ -398,3 +398,57 @@ fn every_standing_model_states_its_angle_axes() {
         assert_eq!(declared, want, "{name}");
     }
 }
+
+/// The shared folder of public recordings, if this checkout sits beside it
+/// (`ACMW_REAL_DATA` names it elsewhere).
+fn real_data() -> Option<std::path::PathBuf> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::env::var_os("ACMW_REAL_DATA")
+        .map(std::path::PathBuf::from)
+        .into_iter()
+        .chain([
+            root.join("../shared/real_data"),
+            root.join("../../shared/real_data"),
+        ])
+        .find(|p| p.join("opensense_example/myIMUMappings.xml").is_file())
+}
+
+/// The OpenSense example's walking trial (Xsens MTw, 100 Hz) after pose
+/// calibration on its first second (standing): hips and knees flex positive,
+/// and the convention check is silent. Skips when the recording is absent.
+#[test]
+fn opensense_walking_flexes_hips_and_knees_positive() {
+    let Some(dir) = real_data() else {
+        eprintln!("skipped: no shared real_data folder beside the checkout");
+        return;
+    };
+    let model = Model::builtin("opensense_lower").unwrap();
+    let path = dir.join("opensense_example/myIMUMappings.xml");
+    let trial = acm_workbench::trial::read_trial(&path, &model).unwrap();
+    let cal = PoseCalibration {
+        at: PoseTime::Span(0.0, 1.0),
+        setup: model.pose,
+    };
+    let cal = calibrate(&trial, &model, &cal).unwrap().0;
+    let w = check_conventions(&cal, &model, &LimitTable::default_table(), true);
+    assert!(w.is_empty(), "{w:?}");
+    for j in ["l_hip", "r_hip", "l_knee", "r_knee", "l_ankle", "r_ankle"] {
+        let y: Vec<f64> = joint_angles(&cal, model.joint(j).unwrap())
+            .unwrap()
+            .iter()
+            .map(|a| a[1])
+            .collect();
+        let mean = y.iter().sum::<f64>() / y.len() as f64;
+        let (min, max) = y
+            .iter()
+            .fold((f64::MAX, f64::MIN), |m, &v| (m.0.min(v), m.1.max(v)));
+        eprintln!("{j} y: mean {mean:.1}, range {min:.1} .. {max:.1}");
+        if j.ends_with("hip") || j.ends_with("knee") {
+            // Walking flexes both by 20 deg and more, never as far the other way.
+            assert!(
+                mean > 0.0 && max > 20.0 && max > -2.0 * min,
+                "{j}: {mean} {min}..{max}"
+            );
+        }
+    }
+}
