@@ -244,9 +244,11 @@ fn plan_joints(
                 reason,
             }),
             None => {
+                // The engine works on the segment frames' Z-Y-X angles.
                 let lim = limits
                     .joint_limits(&joint.name, &joint.kind, variant.centroid())
-                    .expect("checked by skip_reason");
+                    .expect("checked by skip_reason")
+                    .in_segment_frames(joint);
                 todo.push((k, lim));
             }
         }
