@@ -320,35 +320,81 @@ pub fn read_trial_from_str(
 /// Reads only the header of a trial file: format, compression and IMU names.
 /// The header is checked as [`read_trial`] would check it.
 pub fn read_trial_header(path: &Path, model: &Model) -> Result<TrialHeader, TrialError> {
-    if is_xsens_path(path) {
-        let (known, unknown): (Vec<String>, Vec<String>) = super::xsens_trial::imu_names(path)?
-            .into_iter()
-            .partition(|n| model.canonical_imu(n).is_some());
-        return Ok(TrialHeader {
-            format: TrialFormat::Xsens,
-            gzip: false,
-            imus: known
-                .iter()
-                .filter_map(|n| model.canonical_imu(n).map(str::to_string))
-                .collect(),
-            unknown_imus: unknown,
-        });
+    TrialHead::read(path)?.header(model)
+}
+
+/// An Xsens trial's header: its sensor names as `model` knows them.
+fn xsens_header(names: &[String], model: &Model) -> TrialHeader {
+    let (known, unknown): (Vec<&String>, Vec<&String>) =
+        names.iter().partition(|n| model.canonical_imu(n).is_some());
+    TrialHeader {
+        format: TrialFormat::Xsens,
+        gzip: false,
+        imus: known
+            .iter()
+            .filter_map(|n| model.canonical_imu(n).map(str::to_string))
+            .collect(),
+        unknown_imus: unknown.into_iter().cloned().collect(),
     }
-    let (kind, gzip) = kind_or_err(path)?;
-    let head = read_head(path, kind, gzip)?;
-    let format = match kind {
-        Kind::Sto => TrialFormat::Sto,
-        Kind::Csv => first_header(&head).map_or(TrialFormat::QuatCsv, classify_csv_header),
-    };
-    let origin = origin_of(path);
-    let layout = parse_header(&mut LineIter::new(&head), &origin, format, model)?;
-    let (known, unknown): (Vec<_>, Vec<_>) = layout.imus.into_iter().partition(|c| c.known);
-    Ok(TrialHeader {
-        format,
-        gzip,
-        imus: known.into_iter().map(|c| c.name).collect(),
-        unknown_imus: unknown.into_iter().map(|c| c.found).collect(),
-    })
+}
+
+/// The header lines of a trial, read once from disk, to be interpreted with
+/// any number of models ([`TrialHead::header`]).
+#[derive(Debug, Clone)]
+pub struct TrialHead {
+    origin: String,
+    gzip: bool,
+    lines: HeadLines,
+}
+
+#[derive(Debug, Clone)]
+enum HeadLines {
+    /// A CSV or `.sto` file's header lines, in the format they belong to.
+    Text(TrialFormat, String),
+    /// The sensor names of an Xsens trial (mapping or folder of exports).
+    Xsens(Vec<String>),
+}
+
+impl TrialHead {
+    /// Reads the header of the trial at `path` (the first lines only).
+    pub fn read(path: &Path) -> Result<TrialHead, TrialError> {
+        let origin = origin_of(path);
+        if is_xsens_path(path) {
+            let names = super::xsens_trial::imu_names(path)?;
+            return Ok(TrialHead {
+                origin,
+                gzip: false,
+                lines: HeadLines::Xsens(names),
+            });
+        }
+        let (kind, gzip) = kind_or_err(path)?;
+        let head = read_head(path, kind, gzip)?;
+        let format = match kind {
+            Kind::Sto => TrialFormat::Sto,
+            Kind::Csv => first_header(&head).map_or(TrialFormat::QuatCsv, classify_csv_header),
+        };
+        Ok(TrialHead {
+            origin,
+            gzip,
+            lines: HeadLines::Text(format, head),
+        })
+    }
+
+    /// The header as `model` names its IMUs, checked as [`read_trial`] would check it.
+    pub fn header(&self, model: &Model) -> Result<TrialHeader, TrialError> {
+        let (format, head) = match &self.lines {
+            HeadLines::Xsens(names) => return Ok(xsens_header(names, model)),
+            HeadLines::Text(format, head) => (*format, head),
+        };
+        let layout = parse_header(&mut LineIter::new(head), &self.origin, format, model)?;
+        let (known, unknown): (Vec<_>, Vec<_>) = layout.imus.into_iter().partition(|c| c.known);
+        Ok(TrialHeader {
+            format,
+            gzip: self.gzip,
+            imus: known.into_iter().map(|c| c.name).collect(),
+            unknown_imus: unknown.into_iter().map(|c| c.found).collect(),
+        })
+    }
 }
 
 /// Writes a trial in `format`; gzip-compressed when the path ends in `.gz`.

@@ -184,13 +184,15 @@ impl Trial {
 /// mapping only): the one that recognises most of its IMUs, and among those the
 /// one with fewest IMUs the trial lacks (so an 8-sensor OpenSense trial gets
 /// `opensense_lower`, not the 12-IMU `opensim`); the first built-in model when
-/// none recognises any.
+/// none recognises any. The header is read from disk once.
 pub fn detect_model(path: &std::path::Path) -> crate::model::Model {
     use crate::model::{Model, BUILTIN_MODELS};
+    let head = TrialHead::read(path).ok();
     let mut best: Option<((usize, usize), Model)> = None;
     for (name, _) in BUILTIN_MODELS {
         let model = Model::builtin(name).expect("built-in model is valid");
-        let known = read_trial_header(path, &model)
+        let known = (head.as_ref())
+            .and_then(|h| h.header(&model).ok())
             .map(|h| h.imus.iter().filter(|i| model.imus.contains(i)).count())
             .unwrap_or(0);
         let lacking = model.imus.len() - known.min(model.imus.len());
