@@ -7,6 +7,7 @@
 pub mod acm;
 pub mod analysis;
 pub mod baselines;
+pub mod batch;
 pub mod calibration;
 pub mod correct;
 pub mod ik;
