@@ -261,3 +261,76 @@ fn outputs_do_not_depend_on_the_number_of_workers() {
         rows_without_time(&manifest(&b))
     );
 }
+
+#[test]
+fn four_shards_run_at_once_and_merged_equal_one_unsharded_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let trials = write_trials(&dir.path().join("a"), 8, 120.0);
+    copy_dir(&trials, &dir.path().join("b/trials"));
+    let a = dir.path().join("a");
+    // The four shards run at once: start them all, then wait.
+    let children: Vec<_> = (1..=4)
+        .map(|k| {
+            Command::new(env!("CARGO_BIN_EXE_acmw"))
+                .current_dir(&a)
+                .args(["batch", "trials", "--out", "out2", "--jobs", "1", "--quiet"])
+                .args(["--shard", &format!("{k}/4")])
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    let mut per_shard = Vec::new();
+    for c in children {
+        let out = c.wait_with_output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        per_shard.push(String::from_utf8_lossy(&out.stderr).into_owned());
+    }
+    common::acmw_ok(&a, &["batch", "--merge", "--out", "out2"]);
+    common::acmw_ok(
+        &dir.path().join("b"),
+        &["batch", "trials", "--out", "out2", "--jobs", "2", "--quiet"],
+    );
+    let (sharded, whole) = (a.join("out2"), dir.path().join("b/out2"));
+    // Every trial was done by exactly one shard.
+    let counts: Vec<usize> = (1..=4)
+        .map(|k| {
+            Manifest::load(&sharded.join(format!("manifest.shard-{k}-of-4.json")))
+                .unwrap()
+                .rows
+                .len()
+        })
+        .collect();
+    assert_eq!(counts.iter().sum::<usize>(), 8, "{counts:?} {per_shard:?}");
+    let outs = outputs(&sharded);
+    assert_eq!(outs.len(), 16);
+    assert!(outs == outputs(&whole), "sharded outputs differ");
+    let merged = manifest(&sharded);
+    assert_eq!(merged.shard, None);
+    assert_eq!(
+        rows_without_time(&merged),
+        rows_without_time(&manifest(&whole))
+    );
+    // The CSV of the merged manifest is that of the whole run but for times.
+    let csv = |p: &Path| -> Vec<Vec<String>> {
+        let text = std::fs::read_to_string(p.join("manifest.csv")).unwrap();
+        csv::Reader::from_reader(text.as_bytes())
+            .records()
+            .map(|r| {
+                let r = r.unwrap();
+                r.iter().take(r.len() - 1).map(String::from).collect()
+            })
+            .collect()
+    };
+    assert_eq!(csv(&sharded), csv(&whole));
+    // A missing shard is named when merging.
+    std::fs::remove_file(sharded.join("manifest.shard-3-of-4.json")).unwrap();
+    let out = common::acmw(&a, &["batch", "--merge", "--out", "out2"]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("missing for 3/4"), "{stderr}");
+}

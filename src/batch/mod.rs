@@ -501,3 +501,40 @@ impl Batch<'_> {
         (rows, false)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_split_a_list_into_disjoint_parts() {
+        assert_eq!("2/4".parse(), Ok(Shard { index: 2, count: 4 }));
+        for bad in ["0/4", "5/4", "2", "a/4", "1/0"] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+        let names: Vec<PathBuf> = (0..200)
+            .map(|k| PathBuf::from(format!("archive/t{k:04}.csv.gz")))
+            .collect();
+        let mut seen = vec![0usize; names.len()];
+        for index in 1..=4 {
+            for (k, n) in names.iter().enumerate() {
+                if (Shard { index, count: 4 }).holds(n) {
+                    seen[k] += 1;
+                }
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1), "every trial in one shard");
+        // Balanced within binomial spread, and independent of the folder.
+        for index in 1..=4 {
+            let n = names
+                .iter()
+                .filter(|p| (Shard { index, count: 4 }).holds(p))
+                .count();
+            assert!((30..=70).contains(&n), "shard {index}: {n}");
+        }
+        assert_eq!(
+            shard_of(Path::new("a/t0001.csv.gz"), 4),
+            shard_of(Path::new("/mnt/b/t0001.csv.gz"), 4)
+        );
+    }
+}
