@@ -537,4 +537,52 @@ mod tests {
             shard_of(Path::new("/mnt/b/t0001.csv.gz"), 4)
         );
     }
+
+    #[test]
+    fn trials_are_found_in_folders_files_and_patterns_and_outputs_never_collide() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::create_dir_all(d.join("a/sub")).unwrap();
+        for f in [
+            "a/t1.csv",
+            "a/t2.csv.gz",
+            "a/sub/t3.sto",
+            "a/t1.truth.csv.gz",
+            "a/notes.md",
+        ] {
+            std::fs::write(d.join(f), "time,x\n").unwrap();
+        }
+        let s = |p: &str| d.join(p).display().to_string();
+        let found = discover(&[s("a")]).unwrap();
+        assert_eq!(found, [d.join("a/t1.csv"), d.join("a/t2.csv.gz")]);
+        let found = discover(&[s("a/*/*.sto"), s("a/t1.csv"), s("a")]).unwrap();
+        assert_eq!(found.len(), 3, "{found:?}");
+        let e = discover(&[s("nothing/*.csv")]).unwrap_err().to_string();
+        assert!(e.contains("no trial matches"), "{e}");
+        let e = discover(&[s("a/[")]).unwrap_err().to_string();
+        assert!(e.contains("bad pattern"), "{e}");
+        // Two trials of one stem in different folders would share an output.
+        std::fs::write(d.join("a/sub/t1.csv"), "time,x\n").unwrap();
+        let (model, limits, settings) = (
+            Model::infant13(),
+            LimitTable::default_table(),
+            Settings::default(),
+        );
+        let prep = Preparation::default();
+        let batch = Batch {
+            model: Some(&model),
+            limits: &limits,
+            limits_source: "<built-in>",
+            settings: &settings,
+            preparation: &prep,
+            variants: &[Variant::Drift],
+            format: None,
+            out_dir: &d.join("out"),
+            jobs: 1,
+            shard: None,
+        };
+        let trials = discover(&[s("a"), s("a/sub")]).unwrap();
+        let e = batch.check_outputs(&trials).unwrap_err().to_string();
+        assert!(e.contains("would both be written to"), "{e}");
+    }
 }
