@@ -74,8 +74,12 @@ pub fn run(args: BatchArgs) -> anyhow::Result<i32> {
         calibration: load_calibration(args.calibration.as_deref())?,
         pose,
     };
-    let mut variants = args.variant.clone();
-    variants.dedup();
+    let mut variants: Vec<Variant> = Vec::new();
+    for v in &args.variant {
+        if !variants.contains(v) {
+            variants.push(*v);
+        }
+    }
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
