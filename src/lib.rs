@@ -1,8 +1,11 @@
 //! acm-workbench: the Anatomical Constraint Method for IMU joint angles.
 //!
 //! The numerical core (`rotation`, `model`, `limits`, `trial`, `acm`, `calibration`, `metrics`,
-//! `sidecar`, `simulate`, `truth`) knows nothing of the terminal; `ui` and the
-//! `acmw` binary are thin layers over it.
+//! `sidecar`, `simulate`, `truth`, ...) knows nothing of the terminal or the command line:
+//! built with `--no-default-features` the library pulls none of clap, ratatui, crossterm or
+//! notify. The `terminal` feature (on by default, needed by the `acmw` binary) adds `ui`, the
+//! workbench; the command line lives in the binary. Choice types carry their names for
+//! parsers in [`names`].
 
 pub mod acm;
 pub mod analysis;
@@ -13,8 +16,10 @@ pub mod correct;
 pub mod ik;
 pub mod input;
 pub mod limits;
+pub mod located;
 pub mod metrics;
 pub mod model;
+pub mod names;
 pub mod plot;
 pub mod pose;
 pub mod reference;
@@ -25,6 +30,7 @@ pub mod save;
 pub mod sidecar;
 pub mod simulate;
 pub mod trial;
+#[cfg(feature = "terminal")]
 pub mod ui;
 pub mod variant;
 pub mod vertical;

@@ -81,17 +81,9 @@ pub struct LimitTable {
     pub rows: Vec<LimitRow>,
 }
 
-/// A limit table or settings problem, located in its file.
-#[derive(Debug, Clone, thiserror::Error, PartialEq)]
-#[error("{file}:{line}:{column}: {message}")]
-pub struct LimitsError {
-    pub file: String,
-    /// 1-based line; 0 when the problem is the file as a whole.
-    pub line: u64,
-    /// 1-based column (field index); 0 when the whole row or file is meant.
-    pub column: usize,
-    pub message: String,
-}
+/// A limit table or settings problem, located in its file (line 0 when the
+/// file as a whole is meant; column = field index).
+pub type LimitsError = crate::located::LocatedError;
 
 /// Settings of a correction that are not per joint.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -367,9 +359,16 @@ impl LimitTable {
             .clone();
         let found: Vec<&str> = header.iter().collect();
         if found != HEADER {
+            // The first field that differs (1-based), or the first one missing.
+            let column = found
+                .iter()
+                .zip(HEADER)
+                .position(|(f, h)| *f != h)
+                .unwrap_or(found.len().min(HEADER.len()))
+                + 1;
             return Err(err(
                 1,
-                0,
+                column,
                 format!(
                     "expected the header `{}`, found `{}`",
                     HEADER.join(","),
@@ -387,7 +386,14 @@ impl LimitTable {
         for rec in rdr.records() {
             let rec = rec.map_err(|e| {
                 let line = e.position().map_or(0, |p| p.line());
-                err(line, 0, format!("expected 7 fields per row: {e}"))
+                // The first field missing, or the first one too many.
+                let column = match e.kind() {
+                    csv::ErrorKind::UnequalLengths { len, .. } => {
+                        (*len as usize).min(HEADER.len()) + 1
+                    }
+                    _ => 1,
+                };
+                err(line, column, format!("expected 7 fields per row: {e}"))
             })?;
             let line = rec.position().map_or(0, |p| p.line());
             rows.push(parse_row(&rec, line, &err)?);
@@ -646,9 +652,7 @@ fn key_line(text: &str, key: &str) -> u64 {
 }
 
 /// Which minimiser solves the ACM's window costs.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, clap::ValueEnum,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Solver {
     /// Value and gradient in one pass, quasi-Newton steps ([`crate::acm::minimise::minimise_shaped`]).

@@ -392,37 +392,9 @@ impl std::str::FromStr for ReferenceTarget {
     }
 }
 
-/// Why a model file was rejected.
-#[derive(Debug, thiserror::Error)]
-pub enum ModelError {
-    #[error("{path}: cannot read: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
-    #[error("{path}:{line}:{column}: {message}")]
-    Parse {
-        path: String,
-        /// 1-based line, 0 when the file as a whole is meant.
-        line: u64,
-        /// 1-based column (characters), 0 when the whole line is meant.
-        column: usize,
-        message: String,
-    },
-    #[error("{path}:{line}:{column}: {message}")]
-    Invalid {
-        path: String,
-        /// 1-based line of what the message names, 0 when it names nothing.
-        line: u64,
-        /// 1-based column, 0 when the whole line is meant.
-        column: usize,
-        message: String,
-    },
-    #[error(
-        "unknown built-in model '{0}' (known: infant13, opensim, opensense_lower, full_body16)"
-    )]
-    Unknown(String),
-}
+/// Why a model was rejected: a file that cannot be read, parsed or validated,
+/// or an unknown built-in name (the file is then the name itself).
+pub type ModelError = crate::located::LocatedError;
 
 impl Model {
     /// A built-in model by name (see [`BUILTIN_MODELS`]).
@@ -431,7 +403,16 @@ impl Model {
             .iter()
             .find(|(n, _)| *n == name)
             .map(|(_, t)| *t)
-            .ok_or_else(|| ModelError::Unknown(name.to_string()))?;
+            .ok_or_else(|| {
+                let known: Vec<&str> = BUILTIN_MODELS.iter().map(|(n, _)| *n).collect();
+                ModelError::file(
+                    name,
+                    format!(
+                        "unknown built-in model (known: {}; or a path to a model TOML)",
+                        known.join(", ")
+                    ),
+                )
+            })?;
         Model::from_toml(text, &format!("<built-in {name}>"))
     }
 
@@ -447,45 +428,22 @@ impl Model {
         }
         let path = Path::new(name_or_path);
         let text = crate::input::read_text_located(path).map_err(|e| {
-            if e.line > 0 {
-                ModelError::Parse {
-                    path: name_or_path.to_string(),
-                    line: e.line,
-                    column: e.column,
-                    message: e.error.to_string(),
-                }
+            let message = if e.line > 0 {
+                e.error.to_string()
             } else {
-                ModelError::Io {
-                    path: name_or_path.to_string(),
-                    source: e.error,
-                }
-            }
+                format!("cannot read: {}", e.error)
+            };
+            ModelError::at(name_or_path, e.line, e.column, message)
         })?;
         Model::from_toml(&text, name_or_path)
     }
 
     /// Parses and validates a model from TOML text; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Model, ModelError> {
-        let model: Model = toml::from_str(text).map_err(|e| {
-            let (line, column) = e
-                .span()
-                .map(|sp| crate::input::line_col(text, sp.start))
-                .unwrap_or((0, 0));
-            ModelError::Parse {
-                path: origin.to_string(),
-                line,
-                column,
-                message: e.message().trim().to_string(),
-            }
-        })?;
+        let model: Model = toml::from_str(text).map_err(|e| ModelError::toml(origin, text, &e))?;
         model.validate().map_err(|message| {
             let line = crate::input::line_naming(text, &message).unwrap_or(0);
-            ModelError::Invalid {
-                path: origin.to_string(),
-                line,
-                column: usize::from(line > 0),
-                message,
-            }
+            ModelError::at(origin, line, usize::from(line > 0), message)
         })?;
         Ok(model)
     }
@@ -493,12 +451,8 @@ impl Model {
     /// Checks a model that did not come from a file (a sidecar's) as
     /// [`Model::from_toml`] checks one that did; `origin` names it in errors.
     pub fn check(&self, origin: &str) -> Result<(), ModelError> {
-        self.validate().map_err(|message| ModelError::Invalid {
-            path: origin.to_string(),
-            line: 0,
-            column: 0,
-            message,
-        })
+        self.validate()
+            .map_err(|message| ModelError::file(origin, message))
     }
 
     fn validate(&self) -> Result<(), String> {

@@ -18,6 +18,11 @@ pub enum Variant {
     Ik,
     Hinge,
     None,
+    /// `basic` with the centroid term: registered only with the
+    /// `demo-variant` feature, to show that this file is the one place a
+    /// variant is added (`tests/variant_registry.rs`).
+    #[cfg(feature = "demo-variant")]
+    BasicCentroid,
 }
 
 /// Which solver corrects a variant's joints.
@@ -79,7 +84,7 @@ const fn row(
 }
 
 /// Every variant, in the order screens and reports list them.
-pub const VARIANTS: [VariantInfo; 10] = [
+pub const VARIANTS: &[VariantInfo] = &[
     row(
         Variant::Basic,
         "basic",
@@ -174,6 +179,16 @@ pub const VARIANTS: [VariantInfo; 10] = [
         (false, false, false),
         "No correction: the trial as read, after any pose or functional \
          calibration (the step before every other variant).",
+    ),
+    #[cfg(feature = "demo-variant")]
+    row(
+        Variant::BasicCentroid,
+        "basic-centroid",
+        "b+c",
+        "basic-centroid",
+        Kind::Acm,
+        (false, true, false),
+        "As `basic`, with the centroid term (a demonstration variant).",
     ),
 ];
 

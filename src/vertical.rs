@@ -11,9 +11,7 @@ use crate::rotation::{quat_axis_angle_deg, Quat};
 use serde::{Deserialize, Serialize};
 
 /// Which global axis points up.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, clap::ValueEnum,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Vertical {
     /// +Z is up (east-north-up and most fusion filters; the default).

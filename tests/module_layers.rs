@@ -114,3 +114,56 @@ fn the_reader_expands_groups_and_skips_longer_names() {
     assert_eq!(layer("cli::plot::views"), "cli::plot");
     assert_eq!(layer("acm::chain"), "acm");
 }
+
+/// The crates of the terminal and the command line, which the core must not pull.
+const TERMINAL_CRATES: [&str; 5] = ["clap", "ratatui", "crossterm", "notify", "signal-hook"];
+
+/// The package names in `cargo tree`'s normal (non-dev, non-build) dependency
+/// tree of this package with the given feature flags, read offline from the lock file.
+fn normal_dependencies(features: &[&str]) -> BTreeSet<String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["tree", "--offline", "-e", "normal", "--prefix", "none"])
+        .args(["--format", "{p}", "-p", "acm-workbench"])
+        .args(features)
+        .output()
+        .expect("run cargo tree");
+    assert!(
+        out.status.success(),
+        "cargo tree failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn the_library_alone_pulls_no_terminal_crate() {
+    let core = normal_dependencies(&["--no-default-features"]);
+    assert!(
+        core.contains("nalgebra") && core.contains("csv"),
+        "{core:?}"
+    );
+    let pulled: Vec<&str> = TERMINAL_CRATES
+        .iter()
+        .copied()
+        .filter(|c| {
+            core.iter().any(|d| {
+                d == c || d.starts_with(&format!("{c}-")) || d.starts_with(&format!("{c}_"))
+            })
+        })
+        .collect();
+    assert!(pulled.is_empty(), "the core pulls {pulled:?}");
+    // The same query with the workbench's feature lists them all, so the test can fail.
+    let full = normal_dependencies(&[]);
+    for c in TERMINAL_CRATES {
+        assert!(
+            full.contains(c),
+            "{c} missing from the full tree: the query reads nothing"
+        );
+    }
+}

@@ -1,3 +1,4 @@
+#![cfg(feature = "terminal")]
 //! `acmw render SCREEN` prints exactly what the snapshot tests hold, and bare
 //! `acmw` without a terminal says so and exits 4.
 

@@ -4,6 +4,7 @@ use acm_workbench::calibration::AppliedCalibration;
 use acm_workbench::correct::pipeline::{self, Preparation, Prepared, Setup, Source};
 use acm_workbench::limits::{LimitTable, LimitsDir, Settings};
 use acm_workbench::model::{Model, SignedAxis};
+use acm_workbench::names::Named;
 use acm_workbench::pose::{PoseCalibration, PoseTime};
 use acm_workbench::trial::detect_model;
 use acm_workbench::variant::{Variant, VARIANTS};
@@ -35,11 +36,11 @@ pub struct EngineArgs {
     pub hop: Option<f64>,
     /// The global frame's up axis: `z-up`, or `z-down` for north-east-down
     /// recordings [default: from ./joint_limits/settings.toml, else z-up].
-    #[arg(long)]
+    #[arg(long, value_parser = named_parser::<acm_workbench::vertical::Vertical>())]
     pub vertical: Option<acm_workbench::vertical::Vertical>,
     /// Minimiser of the window costs: `gradient`, or `nelder-mead` (the
     /// previous solver, values only, slower) [default: gradient].
-    #[arg(long)]
+    #[arg(long, value_parser = named_parser::<acm_workbench::acm::minimise::Solver>())]
     pub solver: Option<acm_workbench::acm::minimise::Solver>,
     /// Worker threads [default: all cores]; results do not depend on it.
     #[arg(long)]
@@ -252,6 +253,15 @@ impl Progress {
 
 /// The parser of `--variant`: the variant table's names, each with its
 /// description in `--help`.
+/// A parser for a choice type of the library, offering its [`Named::CHOICES`]
+/// with their help lines.
+pub fn named_parser<T: Named + Send + Sync>() -> impl TypedValueParser<Value = T> {
+    let names = T::CHOICES
+        .iter()
+        .map(|c| PossibleValue::new(c.name()).help(c.help()));
+    PossibleValuesParser::new(names).map(|s| T::from_name(&s).expect("a name of the choices"))
+}
+
 pub fn variant_parser() -> impl TypedValueParser<Value = Variant> {
     let names = VARIANTS
         .iter()

@@ -27,7 +27,7 @@ pub struct CorrectArgs {
     #[arg(long, value_parser = variant_parser(), default_value = "drift-centroid")]
     pub variant: Variant,
     /// Output format [default: the input's].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::common::named_parser::<TrialFormat>())]
     pub format: Option<TrialFormat>,
     /// Sidecar JSON path [default: <output>.acmw.json].
     #[arg(long)]

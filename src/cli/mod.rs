@@ -178,10 +178,5 @@ fn parse_poll(s: &str) -> Result<f64, String> {
 
 /// Whether an error comes from malformed input data (exit code 3).
 fn is_bad_input(e: &anyhow::Error) -> bool {
-    e.chain().any(|c| {
-        c.is::<acm_workbench::trial::TrialError>()
-            || c.is::<acm_workbench::limits::LimitsError>()
-            || c.is::<acm_workbench::model::ModelError>()
-            || c.is::<acm_workbench::calibration::CalibrationError>()
-    })
+    acm_workbench::located::is_bad_input(e.as_ref())
 }

@@ -41,10 +41,10 @@ pub enum What {
 #[derive(Debug, Args)]
 pub struct KneeArgs {
     /// The misaligned IMU.
-    #[arg(long, value_enum, default_value = "calf")]
+    #[arg(long, value_parser = super::common::named_parser::<KneeImu>(), default_value = "calf")]
     pub imu: KneeImu,
     /// The sensor axis of the misalignment.
-    #[arg(long, value_enum, default_value = "z")]
+    #[arg(long, value_parser = super::common::named_parser::<KneeAxis>(), default_value = "z")]
     pub axis: KneeAxis,
     /// Misalignment angle, degrees.
     #[arg(long, default_value_t = 15.0, allow_negative_numbers = true)]

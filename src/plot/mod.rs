@@ -18,7 +18,7 @@ use plotters::prelude::*;
 use std::path::Path;
 
 /// The kinds of figure `acmw plot` draws.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PlotKind {
     /// A joint's X, Y and Z angles over time, uncorrected and corrected, with
     /// the limit and centroid lines ([`traces`]).

@@ -127,7 +127,7 @@ pub enum SimKind {
 }
 
 /// Which IMU of the knee test is misaligned.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum KneeImu {
     None,
@@ -136,7 +136,7 @@ pub enum KneeImu {
 }
 
 /// The sensor axis of the knee test's misalignment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum KneeAxis {
     X,

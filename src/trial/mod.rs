@@ -81,7 +81,7 @@ pub struct Trial {
 /// texts say the same).
 pub const ACCEPTED_INPUTS: &str = "a canonical CSV (time,<imu>_qw,_qx,_qy,_qz,...), an Euler CSV (time,<imu>_roll,_pitch,_yaw,...) or an OpenSim .sto, each optionally .gz; an Xsens MT Manager export (.txt or .csv, tab, comma or semicolon separated; one IMU); a folder of such exports; or an OpenSense mapping .xml";
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TrialFormat {
     /// `time,<imu>_qw,<imu>_qx,<imu>_qy,<imu>_qz,...` (canonical CSV).
@@ -92,7 +92,6 @@ pub enum TrialFormat {
     Sto,
     /// Xsens MT Manager exports, one `.txt` per sensor, named by a mapping XML or
     /// a folder (read only; corrected trials are written as `.sto`).
-    #[value(skip)]
     Xsens,
 }
 

@@ -21,7 +21,7 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 pub struct PlotArgs {
     /// What to draw.
-    #[arg(value_enum)]
+    #[arg(value_parser = crate::cli::common::named_parser::<PlotKind>())]
     pub kind: PlotKind,
     /// Trials (any input `acmw correct` reads): `traces` draws the first;
     /// `histogram` pools them all.
