@@ -42,7 +42,7 @@ pub struct BatchArgs {
     #[arg(long, conflicts_with_all = ["inputs", "shard"])]
     pub merge: bool,
     /// Output format [default: the input's].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::common::named_parser::<TrialFormat>())]
     pub format: Option<TrialFormat>,
     /// Apply this functional calibration (`acmw calibrate`) to every trial first.
     #[arg(long)]
