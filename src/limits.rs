@@ -72,6 +72,26 @@ pub struct JointLimits {
     pub lambda2: f64,
 }
 
+impl JointLimits {
+    /// The same limits over the Z-Y-X angles of `joint`'s segment frames (the
+    /// angles the engine computes), from the table's convention: each axis'
+    /// range and centroid moved to the segment axis the joint's `angle_axes`
+    /// names, negated (and the range's ends swapped) where it counts the other
+    /// way. The cost of a rotation is the same either way.
+    pub fn in_segment_frames(&self, joint: &crate::model::Joint) -> JointLimits {
+        let mut range_deg = self.range_deg;
+        for (k, a) in joint.angle_axes.iter().enumerate() {
+            let [lo, hi] = self.range_deg[k];
+            range_deg[a.axis.index()] = if a.negative { [-hi, -lo] } else { [lo, hi] };
+        }
+        JointLimits {
+            range_deg,
+            centroid_deg: self.centroid_deg.map(|c| joint.segment_angles(c)),
+            lambda2: self.lambda2,
+        }
+    }
+}
+
 /// A whole limit table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LimitTable {

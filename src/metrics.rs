@@ -6,20 +6,16 @@
 use crate::acm::cost::excursion;
 use crate::limits::{JointLimits, LimitTable};
 use crate::model::{Joint, Model};
-use crate::rotation::{angle_deg, euler_zyx_deg, wrap180, Quat};
+use crate::rotation::{angle_deg, wrap180, Quat};
 use crate::trial::Trial;
 use serde::{Deserialize, Serialize};
 
-/// Z-Y-X angles `[x, y, z]` (degrees) of a joint per sample, if both IMUs are present.
+/// The joint's angles `[x, y, z]` (degrees, the limit table's convention:
+/// [`Joint::angles`]) per sample, if both IMUs are present.
 pub fn joint_angles(trial: &Trial, joint: &Joint) -> Option<Vec<[f64; 3]>> {
     let p = &trial.imu(&joint.proximal)?.orientation;
     let d = &trial.imu(&joint.distal)?.orientation;
-    Some(
-        p.iter()
-            .zip(d)
-            .map(|(p, d)| euler_zyx_deg(&(p.inverse() * d)))
-            .collect(),
-    )
+    Some(p.iter().zip(d).map(|(p, d)| joint.angles(p, d)).collect())
 }
 
 /// Excursion figures of one joint (Tables 4-1, 4-2 and Figure 4-20).

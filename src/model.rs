@@ -245,7 +245,8 @@ pub struct Joint {
     /// IMU below the joint (the one the ACM corrects).
     pub distal: String,
     /// Degrees of freedom for inverse kinematics: the axes of the joint's
-    /// Z-Y-X angles that move (`["y"]` for a hinge knee); all three when absent.
+    /// angles (table convention) that move (`["y"]` for a hinge knee); all
+    /// three when absent.
     /// The others stay at their `default_pose_deg` value.
     #[serde(default = "all_axes", skip_serializing_if = "is_all_axes")]
     pub dof: Vec<Axis>,
@@ -253,8 +254,9 @@ pub struct Joint {
     /// ACM uses the limit tables).
     #[serde(default, skip_serializing_if = "HardLimits::is_empty")]
     pub hard_limits_deg: HardLimits,
-    /// The joint's Z-Y-X angles `[x, y, z]` in the model's default pose,
-    /// degrees (pose calibration takes the IMUs to show this pose).
+    /// The joint's angles `[x, y, z]` in the model's default pose, degrees,
+    /// in the table's convention (`angle_axes`; pose calibration takes the
+    /// IMUs to show this pose).
     #[serde(default, skip_serializing_if = "is_default")]
     pub default_pose_deg: [f64; 3],
     /// Marks a hinge joint: the `hinge` variant estimates these axes in both
@@ -262,9 +264,95 @@ pub struct Joint {
     /// hinge.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hinge: Option<Hinge>,
+    /// The joint's angles in the limit table's convention (docs/method.md
+    /// section 2.5): entry k names the Z-Y-X angle of the segment frames
+    /// (`x`, `y` or `z` of `(G_R_prox)^T G_R_dist`) that is the table's axis k,
+    /// with its sign: `["-z", "-y", "-x"]` makes the table's X minus the
+    /// segment-frame Z angle, and so on. `["+x", "+y", "+z"]` (the default)
+    /// takes the segment-frame angles as they are. Every joint angle the
+    /// program shows, writes or limits is in the table's convention.
+    #[serde(default = "identity_axes", skip_serializing_if = "is_identity_axes")]
+    pub angle_axes: [SignedAxis; 3],
+}
+
+/// `["+x", "+y", "+z"]`: the table's angles are the segment frames' own.
+pub const IDENTITY_AXES: [SignedAxis; 3] = [
+    SignedAxis {
+        axis: Axis::X,
+        negative: false,
+    },
+    SignedAxis {
+        axis: Axis::Y,
+        negative: false,
+    },
+    SignedAxis {
+        axis: Axis::Z,
+        negative: false,
+    },
+];
+
+fn identity_axes() -> [SignedAxis; 3] {
+    IDENTITY_AXES
+}
+
+fn is_identity_axes(a: &[SignedAxis; 3]) -> bool {
+    *a == IDENTITY_AXES
 }
 
 impl Joint {
+    /// Degrees `[x, y, z]` in the limit table's convention from the Z-Y-X
+    /// angles of the segment frames (see [`Joint::angle_axes`]).
+    pub fn table_angles(&self, segment: [f64; 3]) -> [f64; 3] {
+        if is_identity_axes(&self.angle_axes) {
+            return segment;
+        }
+        self.angle_axes.map(|a| {
+            let v = segment[a.axis.index()];
+            if a.negative {
+                -v
+            } else {
+                v
+            }
+        })
+    }
+
+    /// The inverse of [`Joint::table_angles`]: the segment frames' Z-Y-X
+    /// angles, degrees, of table-convention angles.
+    pub fn segment_angles(&self, table: [f64; 3]) -> [f64; 3] {
+        if is_identity_axes(&self.angle_axes) {
+            return table;
+        }
+        let mut out = [0.0; 3];
+        for (k, a) in self.angle_axes.iter().enumerate() {
+            out[a.axis.index()] = if a.negative { -table[k] } else { table[k] };
+        }
+        out
+    }
+
+    /// Which segment-frame Z-Y-X angle the table's `axis` is, and whether it
+    /// counts the other way.
+    pub fn segment_axis(&self, axis: Axis) -> SignedAxis {
+        self.angle_axes[axis.index()]
+    }
+
+    /// The joint's angles (degrees, table convention) for the segment
+    /// orientations `proximal` and `distal` (segment frame to global).
+    pub fn angles(
+        &self,
+        proximal: &crate::rotation::Quat,
+        distal: &crate::rotation::Quat,
+    ) -> [f64; 3] {
+        self.table_angles(crate::rotation::euler_zyx_deg(
+            &(proximal.inverse() * distal),
+        ))
+    }
+
+    /// The joint rotation (distal segment frame in the proximal one) whose
+    /// angles in the table's convention are `table` (degrees).
+    pub fn rotation(&self, table: [f64; 3]) -> crate::rotation::Quat {
+        crate::rotation::quat_from_euler_zyx_deg(self.segment_angles(table))
+    }
+
     /// Whether inverse kinematics moves this axis.
     pub fn moves(&self, axis: Axis) -> bool {
         self.dof.contains(&axis)
@@ -272,6 +360,14 @@ impl Joint {
 
     fn validate(&self) -> Result<(), String> {
         let name = &self.name;
+        for (k, a) in self.angle_axes.iter().enumerate() {
+            if self.angle_axes[..k].iter().any(|b| b.axis == a.axis) {
+                return Err(format!(
+                    "joint '{name}': angle_axes names the segment axis '{}' twice (expected each of x, y, z once, e.g. [\"-z\", \"-y\", \"-x\"])",
+                    a.axis.name()
+                ));
+            }
+        }
         for (k, a) in self.dof.iter().enumerate() {
             if self.dof[..k].contains(a) {
                 return Err(format!(

@@ -16,7 +16,7 @@
 //! calibration do not depend on which way the subject faced.
 
 use crate::model::{Model, PoseSetup};
-use crate::rotation::{canonical, quat_axis_angle_deg, quat_from_euler_zyx_deg, wxyz, Quat};
+use crate::rotation::{canonical, quat_axis_angle_deg, wxyz, Quat};
 use crate::trial::Trial;
 use nalgebra::{Matrix4, Quaternion, Vector3};
 use serde::{Deserialize, Serialize};
@@ -128,10 +128,7 @@ pub fn default_pose(model: &Model) -> BTreeMap<String, Quat> {
             .get(&j.proximal)
             .copied()
             .unwrap_or_else(Quat::identity);
-        pose.insert(
-            j.distal.clone(),
-            parent * quat_from_euler_zyx_deg(j.default_pose_deg),
-        );
+        pose.insert(j.distal.clone(), parent * j.rotation(j.default_pose_deg));
     }
     pose
 }

@@ -208,15 +208,7 @@ pub fn mismatch_warning(path: &Path, bytes: &[u8]) -> Option<String> {
 /// The default output path of a corrected trial:
 /// `corrected/<stem>.<variant>.<ext>[.gz]` in the input's folder.
 pub fn default_output(input: &Path, variant: Variant, format: TrialFormat, gzip: bool) -> PathBuf {
-    let name = input.file_name().unwrap_or_default().to_string_lossy();
-    let lower = name.to_ascii_lowercase();
-    let mut stem_len = name.len();
-    for ext in [".gz", ".csv", ".sto", ".xml"] {
-        if lower[..stem_len].ends_with(ext) {
-            stem_len -= ext.len();
-        }
-    }
-    let stem = &name[..stem_len];
+    let stem = crate::file_names::stem_without(input, &crate::file_names::TRIAL_SUFFIXES);
     let ext = match format {
         TrialFormat::Sto => "sto",
         _ => "csv",

@@ -156,30 +156,18 @@ fn run(
     } else {
         whole_trial(&trial.time_s)
     };
-    let mut corrected = trial.clone();
-    let mut skipped = Vec::new();
-    let mut todo: Vec<(usize, JointLimits)> = Vec::new();
-    for (k, joint) in model.joints.iter().enumerate() {
-        match skip_reason(trial, joint, limits) {
-            Some(reason) => skipped.push(SkippedJoint {
-                joint: joint.name.clone(),
-                reason,
-            }),
-            None => {
-                let lim = limits
-                    .joint_limits(&joint.name, &joint.kind, variant.centroid())
-                    .expect("checked by skip_reason");
-                todo.push((k, lim));
-            }
-        }
-    }
+    let (todo, skipped) = plan_joints(trial, model, limits, variant);
     let mut hinges = hinge_fits(trial, model, &todo, variant, &windows);
     let solve_count = todo
         .iter()
         .filter(|(k, _)| reuse.is_none_or(|(_, redo)| redo.contains(k)))
         .count();
-    let total = solve_count * windows.len();
-    let done = AtomicUsize::new(0);
+    let progress = Progress {
+        done: AtomicUsize::new(0),
+        total: solve_count * windows.len(),
+        control,
+    };
+    let mut corrected = trial.clone();
     let depths = model.joint_depths();
     let mut results: HashMap<usize, JointResult> = HashMap::new();
     let mut headings: HashMap<usize, ImuHeading> = HashMap::new();
@@ -198,151 +186,29 @@ fn run(
                 &windows,
             );
         }
-        let solved: Vec<(usize, JointResult, Applied, Option<ImuHeading>)> = level
+        let pass = Pass {
+            trial,
+            model,
+            settings,
+            variant,
+            reuse,
+            windows: &windows,
+            todo: &todo,
+            hinges: &hinges,
+            corrected: &corrected,
+            results: &results,
+            progress: &progress,
+        };
+        let solved: Vec<Solved> = level
             .par_iter()
-            .map(|(k, lim)| {
-                let joint = &model.joints[*k];
-                let parent_corrected = results_has_imu(&results, model, &joint.proximal);
-                if let Some((prev, redo)) = reuse {
-                    if !redo.contains(k) {
-                        if let Some(r) = prev.joint(&joint.name) {
-                            let kept = prev.corrected.imu(&joint.distal).expect("present");
-                            let heading = prev.heading(&joint.distal).cloned();
-                            let applied =
-                                Applied::Kept(kept.orientation.clone(), kept.gyro.clone());
-                            return Ok((*k, r.clone(), applied, heading));
-                        }
-                    }
-                }
-                let parent_series = corrected.imu(&joint.proximal).expect("present");
-                let child_series = trial.imu(&joint.distal).expect("present");
-                let parent = &parent_series.orientation;
-                let child = &child_series.orientation;
-                let progress = || {
-                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                    if let Some(p) = control.progress {
-                        p(d, total);
-                    }
-                };
-                let families = axis_families(model, &todo, &hinges, *k);
-                let result = |windows, baseline| JointResult {
-                    joint: joint.name.clone(),
-                    proximal: joint.proximal.clone(),
-                    distal: joint.distal.clone(),
-                    lambda2: lim.lambda2,
-                    parent_corrected,
-                    windows,
-                    baseline,
-                    hinge: hinges.get(k).map(|f| f.record.clone()),
-                    axis_from: families.as_ref().and_then(|f| f.from_child.clone()),
-                };
-                if variant.heading() {
-                    if control.cancelled() {
-                        return Err(Cancelled);
-                    }
-                    let problem = HeadingProblem {
-                        parent,
-                        child,
-                        windows: &windows,
-                        limits: lim,
-                        lambda1: settings.lambda1,
-                        vertical: settings.vertical,
-                    };
-                    let children: Vec<ChildJoint> = todo
-                        .iter()
-                        .filter(|(c, _)| model.joints[*c].proximal == joint.distal)
-                        .map(|(c, limits)| ChildJoint {
-                            child: &trial
-                                .imu(&model.joints[*c].distal)
-                                .expect("present")
-                                .orientation,
-                            limits,
-                        })
-                        .collect();
-                    let lookahead = Lookahead {
-                        own: problem,
-                        children: &children,
-                    };
-                    let (sol, heading, orientation) =
-                        solve_heading(&trial.time_s, &lookahead, &joint.name, &joint.distal);
-                    windows.iter().for_each(|_| progress());
-                    let c_inv = quat_from_wxyz(heading.correction).inverse();
-                    let gyro =
-                        (child_series.gyro.as_ref()).map(|g| g.iter().map(|w| c_inv * w).collect());
-                    let applied = Applied::Kept(orientation, gyro);
-                    return Ok((*k, result(sol, None), applied, Some(heading)));
-                }
-                let measured: Vec<Quat> = parent
-                    .iter()
-                    .zip(child)
-                    .map(|(p, c)| p.inverse() * c)
-                    .collect();
-                let gyros = match (&parent_series.gyro, &child_series.gyro) {
-                    (Some(p), Some(c)) => Some(baselines::JointGyros {
-                        proximal: p,
-                        distal: c,
-                    }),
-                    _ => None,
-                };
-                if let Some(method) = baselines::method_for(variant, &joint.kind) {
-                    let (sol, baseline, gyro) = solve_baseline(
-                        method,
-                        (&trial.time_s, &measured, gyros),
-                        &windows,
-                        control,
-                        &progress,
-                    )?;
-                    let applied = Applied::Series(sol.series, GyroUpdate::Replace(gyro));
-                    return Ok((*k, result(sol.windows, baseline), applied, None));
-                }
-                let sol = match &families {
-                    Some(f) => solve_windows_with_axes(
-                        (&trial.time_s, &measured),
-                        &windows,
-                        (lim, settings.lambda1, settings.solver),
-                        &f.per_window,
-                        control,
-                        &progress,
-                    )?,
-                    None => solve_windows(
-                        &trial.time_s,
-                        &measured,
-                        &windows,
-                        (lim, settings.lambda1, settings.solver),
-                        control,
-                        &progress,
-                    )?,
-                };
-                let applied = Applied::Series(sol.series, GyroUpdate::Turn);
-                Ok((*k, result(sol.windows, None), applied, None))
-            })
+            .map(|(k, lim)| pass.solve_joint(*k, lim))
             .collect::<Result<_, Cancelled>>()?;
         for (k, result, applied, heading) in solved {
             if let Some(h) = heading {
                 headings.insert(k, h);
             }
             let distal = &model.joints[k].distal;
-            let imu = corrected.imu_mut(distal).expect("present");
-            match applied {
-                Applied::Series(series, gyro) => {
-                    for (q, c) in imu.orientation.iter_mut().zip(&series) {
-                        *q = Quat::new_normalize((*q * c).into_inner());
-                    }
-                    match (gyro, &mut imu.gyro) {
-                        (GyroUpdate::Turn, Some(g)) => {
-                            for (w, c) in g.iter_mut().zip(&series) {
-                                *w = c.inverse() * *w;
-                            }
-                        }
-                        (GyroUpdate::Turn, None) => {}
-                        (GyroUpdate::Replace(g), _) => imu.gyro = g,
-                    }
-                }
-                Applied::Kept(orientation, gyro) => {
-                    imu.orientation = orientation;
-                    imu.gyro = gyro;
-                }
-            }
+            apply_to(corrected.imu_mut(distal).expect("present"), applied);
             results.insert(k, result);
         }
     }
@@ -359,6 +225,239 @@ fn run(
         skipped,
         ik: None,
     })
+}
+
+/// The joints to correct, each with its limits (by index in the model's
+/// joints), and those skipped with the reason.
+fn plan_joints(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    variant: Variant,
+) -> (Vec<(usize, JointLimits)>, Vec<SkippedJoint>) {
+    let mut skipped = Vec::new();
+    let mut todo: Vec<(usize, JointLimits)> = Vec::new();
+    for (k, joint) in model.joints.iter().enumerate() {
+        match skip_reason(trial, joint, limits) {
+            Some(reason) => skipped.push(SkippedJoint {
+                joint: joint.name.clone(),
+                reason,
+            }),
+            None => {
+                // The engine works on the segment frames' Z-Y-X angles.
+                let lim = limits
+                    .joint_limits(&joint.name, &joint.kind, variant.centroid())
+                    .expect("checked by skip_reason")
+                    .in_segment_frames(joint);
+                todo.push((k, lim));
+            }
+        }
+    }
+    (todo, skipped)
+}
+
+/// Windows solved so far over the whole run, reported through the run's control.
+struct Progress<'a> {
+    done: AtomicUsize,
+    /// Windows to solve in all.
+    total: usize,
+    control: &'a RunControl<'a>,
+}
+
+impl Progress<'_> {
+    /// Counts one window solved and reports it.
+    fn window_done(&self) {
+        let d = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        if let Some(p) = self.control.progress {
+            p(d, self.total);
+        }
+    }
+}
+
+/// One joint's outcome: its index, result, what to apply to its distal IMU
+/// and, for the heading variants, its heading fit.
+type Solved = (usize, JointResult, Applied, Option<ImuHeading>);
+
+/// What every joint of one depth of the chain reads while the joints of that
+/// depth are solved in parallel.
+struct Pass<'a> {
+    trial: &'a Trial,
+    model: &'a Model,
+    settings: &'a Settings,
+    variant: Variant,
+    reuse: Option<(&'a Correction, &'a BTreeSet<usize>)>,
+    windows: &'a [Window],
+    todo: &'a [(usize, JointLimits)],
+    hinges: &'a HashMap<usize, HingeFits>,
+    /// The trial with the joints above this depth corrected.
+    corrected: &'a Trial,
+    /// The joints solved above this depth.
+    results: &'a HashMap<usize, JointResult>,
+    progress: &'a Progress<'a>,
+}
+
+impl Pass<'_> {
+    /// Solves joint `k` (or keeps an earlier run's result for it) with the
+    /// variant's solver.
+    fn solve_joint(&self, k: usize, lim: &JointLimits) -> Result<Solved, Cancelled> {
+        let joint = &self.model.joints[k];
+        if let Some(kept) = self.kept(k) {
+            return Ok(kept);
+        }
+        let families = axis_families(self.model, self.todo, self.hinges, k);
+        let result = |windows, baseline| JointResult {
+            joint: joint.name.clone(),
+            proximal: joint.proximal.clone(),
+            distal: joint.distal.clone(),
+            lambda2: lim.lambda2,
+            parent_corrected: results_has_imu(self.results, self.model, &joint.proximal),
+            windows,
+            baseline,
+            hinge: self.hinges.get(&k).map(|f| f.record.clone()),
+            axis_from: families.as_ref().and_then(|f| f.from_child.clone()),
+        };
+        if self.variant.heading() {
+            let (windows, applied, heading) = self.solve_heading_joint(joint, lim)?;
+            return Ok((k, result(windows, None), applied, Some(heading)));
+        }
+        let parent_series = self.corrected.imu(&joint.proximal).expect("present");
+        let child_series = self.trial.imu(&joint.distal).expect("present");
+        let measured: Vec<Quat> = parent_series
+            .orientation
+            .iter()
+            .zip(&child_series.orientation)
+            .map(|(p, c)| p.inverse() * c)
+            .collect();
+        let control = self.progress.control;
+        let progress = || self.progress.window_done();
+        if let Some(method) = baselines::method_for(self.variant, &joint.kind) {
+            let gyros = match (&parent_series.gyro, &child_series.gyro) {
+                (Some(p), Some(c)) => Some(baselines::JointGyros {
+                    proximal: p,
+                    distal: c,
+                }),
+                _ => None,
+            };
+            let (sol, baseline, gyro) = solve_baseline(
+                method,
+                (&self.trial.time_s, &measured, gyros),
+                self.windows,
+                control,
+                &progress,
+            )?;
+            let applied = Applied::Series(sol.series, GyroUpdate::Replace(gyro));
+            return Ok((k, result(sol.windows, baseline), applied, None));
+        }
+        let settings = self.settings;
+        let sol = match &families {
+            Some(f) => solve_windows_with_axes(
+                (&self.trial.time_s, &measured),
+                self.windows,
+                (lim, settings.lambda1, settings.solver),
+                &f.per_window,
+                control,
+                &progress,
+            )?,
+            None => solve_windows(
+                &self.trial.time_s,
+                &measured,
+                self.windows,
+                (lim, settings.lambda1, settings.solver),
+                control,
+                &progress,
+            )?,
+        };
+        let applied = Applied::Series(sol.series, GyroUpdate::Turn);
+        Ok((k, result(sol.windows, None), applied, None))
+    }
+
+    /// An earlier run's result for joint `k`, when the run re-solves other joints only.
+    fn kept(&self, k: usize) -> Option<Solved> {
+        let (prev, redo) = self.reuse?;
+        if redo.contains(&k) {
+            return None;
+        }
+        let joint = &self.model.joints[k];
+        let r = prev.joint(&joint.name)?;
+        let kept = prev.corrected.imu(&joint.distal).expect("present");
+        let heading = prev.heading(&joint.distal).cloned();
+        let applied = Applied::Kept(kept.orientation.clone(), kept.gyro.clone());
+        Some((k, r.clone(), applied, heading))
+    }
+
+    /// The heading variants' fit of `joint`'s distal IMU, looking ahead to the
+    /// joints below it: the window solutions, the corrected series and the fit.
+    fn solve_heading_joint(
+        &self,
+        joint: &Joint,
+        lim: &JointLimits,
+    ) -> Result<(Vec<WindowSolution>, Applied, ImuHeading), Cancelled> {
+        if self.progress.control.cancelled() {
+            return Err(Cancelled);
+        }
+        let (trial, model) = (self.trial, self.model);
+        let child_series = trial.imu(&joint.distal).expect("present");
+        let problem = HeadingProblem {
+            parent: &self
+                .corrected
+                .imu(&joint.proximal)
+                .expect("present")
+                .orientation,
+            child: &child_series.orientation,
+            windows: self.windows,
+            limits: lim,
+            lambda1: self.settings.lambda1,
+            vertical: self.settings.vertical,
+        };
+        let children: Vec<ChildJoint> = self
+            .todo
+            .iter()
+            .filter(|(c, _)| model.joints[*c].proximal == joint.distal)
+            .map(|(c, limits)| ChildJoint {
+                child: &trial
+                    .imu(&model.joints[*c].distal)
+                    .expect("present")
+                    .orientation,
+                limits,
+            })
+            .collect();
+        let lookahead = Lookahead {
+            own: problem,
+            children: &children,
+        };
+        let (sol, heading, orientation) =
+            solve_heading(&trial.time_s, &lookahead, &joint.name, &joint.distal);
+        self.windows
+            .iter()
+            .for_each(|_| self.progress.window_done());
+        let c_inv = quat_from_wxyz(heading.correction).inverse();
+        let gyro = (child_series.gyro.as_ref()).map(|g| g.iter().map(|w| c_inv * w).collect());
+        Ok((sol, Applied::Kept(orientation, gyro), heading))
+    }
+}
+
+/// Applies a joint's outcome to its distal IMU's orientations and gyros.
+fn apply_to(imu: &mut crate::trial::ImuSeries, applied: Applied) {
+    match applied {
+        Applied::Series(series, gyro) => {
+            for (q, c) in imu.orientation.iter_mut().zip(&series) {
+                *q = Quat::new_normalize((*q * c).into_inner());
+            }
+            match (gyro, &mut imu.gyro) {
+                (GyroUpdate::Turn, Some(g)) => {
+                    for (w, c) in g.iter_mut().zip(&series) {
+                        *w = c.inverse() * *w;
+                    }
+                }
+                (GyroUpdate::Turn, None) => {}
+                (GyroUpdate::Replace(g), _) => imu.gyro = g,
+            }
+        }
+        Applied::Kept(orientation, gyro) => {
+            imu.orientation = orientation;
+            imu.gyro = gyro;
+        }
+    }
 }
 
 /// The hinge joints' axes per window (the `hinge` variant; empty otherwise),

@@ -170,8 +170,8 @@ fn pool(
         .collect()
 }
 
-/// Z-Y-X angles (degrees) of `joint` for the samples in `range`, if the trial
-/// has both IMUs.
+/// The angles (degrees, the table's convention) of `joint` for the samples in
+/// `range`, if the trial has both IMUs.
 fn joint_angles_in(
     trial: &Trial,
     joint: &crate::model::Joint,
@@ -180,11 +180,7 @@ fn joint_angles_in(
     let p = &trial.imu(&joint.proximal)?.orientation;
     let d = &trial.imu(&joint.distal)?.orientation;
     let range = range.start.min(p.len())..range.end.min(p.len()).min(d.len());
-    Some(
-        range
-            .map(|i| crate::rotation::euler_zyx_deg(&(p[i].inverse() * d[i])))
-            .collect(),
-    )
+    Some(range.map(|i| joint.angles(&p[i], &d[i])).collect())
 }
 
 #[cfg(test)]

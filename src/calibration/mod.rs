@@ -282,15 +282,8 @@ fn calibrate_segment(
 /// The default calibration file of a recording: `<stem>.calibration.toml`
 /// beside it (`walk.calib.csv.gz` -> `walk.calibration.toml`).
 pub fn default_output(recording: &Path) -> PathBuf {
-    let name = recording.file_name().unwrap_or_default().to_string_lossy();
-    let lower = name.to_ascii_lowercase();
-    let mut stem_len = name.len();
-    for ext in [".gz", ".csv", ".calib"] {
-        if lower[..stem_len].ends_with(ext) {
-            stem_len -= ext.len();
-        }
-    }
-    recording.with_file_name(format!("{}.calibration.toml", &name[..stem_len]))
+    let stem = crate::file_names::stem_without(recording, &crate::file_names::RECORDING_SUFFIXES);
+    recording.with_file_name(format!("{stem}.calibration.toml"))
 }
 
 impl Calibration {

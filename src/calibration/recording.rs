@@ -49,16 +49,7 @@ pub struct Recording {
 
 const CHANNELS: [&str; 6] = ["ax", "ay", "az", "gx", "gy", "gz"];
 
-/// True when the file name marks a calibration recording: `*.calib.csv` or
-/// `*.calib.csv.gz` (case-insensitive).
-pub fn is_calibration_recording(path: &Path) -> bool {
-    let Some(name) = path.file_name() else {
-        return false;
-    };
-    let name = name.to_string_lossy().to_ascii_lowercase();
-    let stem = name.strip_suffix(".gz").unwrap_or(&name);
-    stem.ends_with(".calib.csv") && stem.len() > ".calib.csv".len()
-}
+pub use crate::file_names::is_calibration_recording;
 
 impl Recording {
     /// Number of rows.

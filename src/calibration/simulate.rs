@@ -354,15 +354,8 @@ pub fn simulate(
 /// (`x.calib.csv.gz` -> `x.calib.truth.json`), holding the configuration with
 /// every true rotation.
 pub fn truth_path(recording: &std::path::Path) -> std::path::PathBuf {
-    let name = recording.file_name().unwrap_or_default().to_string_lossy();
-    let lower = name.to_ascii_lowercase();
-    let mut stem_len = name.len();
-    for ext in [".gz", ".csv"] {
-        if lower[..stem_len].ends_with(ext) {
-            stem_len -= ext.len();
-        }
-    }
-    recording.with_file_name(format!("{}.truth.json", &name[..stem_len]))
+    let stem = crate::file_names::stem_without(recording, &crate::file_names::CSV_SUFFIXES);
+    recording.with_file_name(format!("{stem}.truth.json"))
 }
 
 /// The true rotations SF -> FF per IMU from the truth file beside a recording,

@@ -10,15 +10,8 @@ use std::path::{Path, PathBuf};
 /// Where the coordinates of the corrected trial `output` go:
 /// `<output without .csv/.sto/.gz>.coordinates.csv` beside it.
 pub fn coordinates_path(output: &Path) -> PathBuf {
-    let name = output.file_name().unwrap_or_default().to_string_lossy();
-    let lower = name.to_ascii_lowercase();
-    let mut stem_len = name.len();
-    for ext in [".gz", ".csv", ".sto"] {
-        if lower[..stem_len].ends_with(ext) {
-            stem_len -= ext.len();
-        }
-    }
-    output.with_file_name(format!("{}.coordinates.csv", &name[..stem_len]))
+    let stem = crate::file_names::stem_without(output, &crate::file_names::OUTPUT_SUFFIXES);
+    output.with_file_name(format!("{stem}.coordinates.csv"))
 }
 
 /// The coordinates file as text.

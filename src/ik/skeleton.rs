@@ -4,7 +4,9 @@
 //! Segment orientations (segment frame to global frame G):
 //! `S_base = B` (a free rotation), `S_distal = S_proximal * Rz(z) Ry(y) Rx(x)`,
 //! where each of `x, y, z` is a coordinate when the joint declares it in `dof`
-//! and its `default_pose_deg` value otherwise. Coordinates are radians inside
+//! and its `default_pose_deg` value otherwise (coordinates, `dof`, hard limits
+//! and the default pose are in the table's convention, each landing on the
+//! segment axis the joint's `angle_axes` names, with its sign). Coordinates are radians inside
 //! the solver, degrees in every output.
 
 use crate::model::{Axis, Model};
@@ -41,9 +43,13 @@ pub struct Segment {
     pub imu: String,
     /// Index of the parent segment (None for the base).
     pub parent: Option<usize>,
-    /// Per Euler axis `[x, y, z]`: the coordinate index, or None when fixed.
+    /// Per Z-Y-X angle `[x, y, z]` of the segment frames: the coordinate
+    /// index, or None when fixed. A coordinate is a joint angle in the table's
+    /// convention (`angle_axes`), so it lands on its segment axis with `sign`.
     pub coordinate: [Option<usize>; 3],
-    /// Values of the fixed axes, radians (from `default_pose_deg`).
+    /// Per segment axis: -1 where the coordinate counts the other way.
+    pub sign: [f64; 3],
+    /// Values of the segment-frame angles, radians (from `default_pose_deg`).
     pub fixed: [f64; 3],
     /// Weight of this IMU's orientation error.
     pub weight: f64,
@@ -75,6 +81,7 @@ impl Skeleton {
             imu: model.base.clone(),
             parent: None,
             coordinate: [None; 3],
+            sign: [1.0; 3],
             fixed: [0.0; 3],
             weight: model.weight(&model.base),
             columns: (0..BASE_COLUMNS).collect(),
@@ -103,13 +110,18 @@ impl Skeleton {
             let parent = parent.expect("checked above");
             let mut columns = segments[parent].columns.clone();
             let mut coordinate = [None; 3];
+            let mut sign = [1.0; 3];
             for axis in Axis::ALL.into_iter().filter(|a| j.moves(*a)) {
                 let [lower, upper] = j
                     .hard_limits_deg
                     .get(axis)
                     .map(|l| l.map(f64::to_radians))
                     .unwrap_or([f64::NEG_INFINITY, f64::INFINITY]);
-                coordinate[axis.index()] = Some(coordinates.len());
+                let on = j.segment_axis(axis);
+                coordinate[on.axis.index()] = Some(coordinates.len());
+                if on.negative {
+                    sign[on.axis.index()] = -1.0;
+                }
                 columns.push(BASE_COLUMNS + coordinates.len());
                 coordinates.push(Coordinate {
                     joint: j.name.clone(),
@@ -123,7 +135,8 @@ impl Skeleton {
                 imu: j.distal.clone(),
                 parent: Some(parent),
                 coordinate,
-                fixed: j.default_pose_deg.map(f64::to_radians),
+                sign,
+                fixed: j.segment_angles(j.default_pose_deg).map(f64::to_radians),
                 weight: model.weight(&j.distal),
                 columns,
             });
@@ -140,13 +153,14 @@ impl Skeleton {
         BASE_COLUMNS + self.coordinates.len()
     }
 
-    /// `[x, y, z]` of a segment's joint (radians) for coordinates `q`.
+    /// The segment frames' Z-Y-X angles `[x, y, z]` of a segment's joint
+    /// (radians) for coordinates `q`.
     pub fn joint_angles(&self, segment: usize, q: &[f64]) -> [f64; 3] {
         let s = &self.segments[segment];
         let mut a = s.fixed;
         for (k, c) in s.coordinate.iter().enumerate() {
             if let Some(c) = c {
-                a[k] = q[*c];
+                a[k] = s.sign[k] * q[*c];
             }
         }
         a

@@ -152,7 +152,7 @@ impl<'a> Solver<'a> {
             for (axis, c) in s.coordinate.iter().enumerate() {
                 if let Some(c) = *c {
                     let co = &sk.coordinates[c];
-                    pose.q[c] = e[axis].clamp(co.lower, co.upper);
+                    pose.q[c] = (s.sign[axis] * e[axis]).clamp(co.lower, co.upper);
                 }
             }
             self.orient[k] = self.orient[p] * joint_rotation(sk.joint_angles(k, &pose.q));
@@ -356,13 +356,13 @@ pub fn forward(sk: &Skeleton, pose: &Pose, orient: &mut [Quat], axes: &mut [Vect
         let pz = p * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), z);
         let pzy = pz * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), y);
         if let Some(c) = s.coordinate[2] {
-            axes[c] = p * Vector3::z();
+            axes[c] = (p * Vector3::z()) * s.sign[2];
         }
         if let Some(c) = s.coordinate[1] {
-            axes[c] = pz * Vector3::y();
+            axes[c] = (pz * Vector3::y()) * s.sign[1];
         }
         if let Some(c) = s.coordinate[0] {
-            axes[c] = pzy * Vector3::x();
+            axes[c] = (pzy * Vector3::x()) * s.sign[0];
         }
         orient[k] = pzy * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), x);
     }

@@ -11,10 +11,10 @@
 //! * **mirrored** (calibrated trials only): on such an axis the angles reach
 //!   at least [`MIN_MOTION_DEG`] the unexpected way and more than
 //!   [`MIRROR_RATIO`] times as far as the expected way. On a knee (every
-//!   built-in model counts knee flexion on +Y in the calibrated frames) that
-//!   points at the heading, i.e. `--base-forward`: a heading off by 180 deg
-//!   turns the segment frames' X and Y round; on other joints, at the model's
-//!   frames counting that joint the other way.
+//!   built-in model's `angle_axes` count knee flexion positive in the frames of
+//!   its pose) that points at the heading, i.e. `--base-forward`: a heading
+//!   off by 180 deg turns the segment frames' X and Y round; on other joints,
+//!   at the model's `angle_axes` counting that joint the other way.
 //! * **offset**: more than [`OFFSET_SHARE`] of the samples beyond one limit
 //!   while none reach the other: an offset calibration pose, or none.
 //! * **axes swapped** (calibrated): a narrow axis (range within +-10 deg)
@@ -75,8 +75,9 @@ pub fn check_conventions(
             let [lo, hi] = lim.range_deg[k];
             let mut v: Vec<f64> = angles.iter().map(|a| a[k]).collect();
             let n = v.len() as f64;
-            let below = v.iter().filter(|&&x| x < lo).count() as f64 / n;
-            let above = v.iter().filter(|&&x| x > hi).count() as f64 / n;
+            // Within 1e-9 deg of a limit is on it (rounding of a joint held there).
+            let below = v.iter().filter(|&&x| x < lo - 1e-9).count() as f64 / n;
+            let above = v.iter().filter(|&&x| x > hi + 1e-9).count() as f64 / n;
             let (p2, p98) = (percentile(&mut v, 0.02), percentile(&mut v, 0.98));
             reach[k] = [(-p2).max(0.0), p98.max(0.0)];
             let name = format!("{} {}", joint.name, axis.name());
@@ -105,8 +106,8 @@ pub fn check_conventions(
                     "the heading of the pose calibration is likely 180 deg off: check --base-forward (the base IMU's forward axis in the pose)".to_string()
                 } else {
                     format!(
-                        "the model's {} frames likely count this axis the other way (or the heading is off: --base-forward)",
-                        joint.kind
+                        "the model's angle_axes for {} likely count this axis the other way, or its pose is not the one held (or the heading is off: --base-forward)",
+                        joint.name
                     )
                 };
                 out.push(format!(
@@ -147,20 +148,22 @@ pub fn check_conventions(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rotation::{quat_from_euler_zyx_deg, Quat};
+    use crate::rotation::{quat_axis_angle_deg, Quat};
     use crate::trial::ImuSeries;
 
-    /// Pelvis still, right hip and knee flexing on Y by `hip(t)` and `knee(t)`.
+    /// Pelvis still in the standing pose's frame (x forward, y left, z up),
+    /// the right hip flexing by `hip(t)` (the thigh swinging forward, about
+    /// -y) and the knee by `knee(t)` (the shank folding back, about +y).
     fn trial(hip: impl Fn(f64) -> f64, knee: impl Fn(f64) -> f64) -> Trial {
         let time_s: Vec<f64> = (0..500).map(|i| i as f64 / 50.0).collect();
         let thigh: Vec<Quat> = time_s
             .iter()
-            .map(|&t| quat_from_euler_zyx_deg([0.0, hip(t), 0.0]))
+            .map(|&t| quat_axis_angle_deg([0.0, -1.0, 0.0], hip(t)))
             .collect();
         let shank: Vec<Quat> = thigh
             .iter()
             .zip(&time_s)
-            .map(|(q, &t)| q * quat_from_euler_zyx_deg([0.0, knee(t), 0.0]))
+            .map(|(q, &t)| q * quat_axis_angle_deg([0.0, 1.0, 0.0], knee(t)))
             .collect();
         Trial {
             name: "t".to_string(),

@@ -302,6 +302,42 @@ pub fn compare(
     })
 }
 
+/// A reference as the trial screen draws it: per joint and axis the
+/// reference's angle (degrees) at each trial sample's time plus the lag, NaN
+/// where it has none.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReferenceTrace {
+    /// The reference file as named.
+    pub origin: String,
+    /// The reference is read at trial time + lag, seconds (found as `report
+    /// --reference` finds it, within +-`max_lag_s`).
+    pub lag_s: f64,
+    /// Per joint: per axis X, Y, Z the values at the trial's samples, or None
+    /// when the reference has no channel for that axis.
+    pub joints: std::collections::BTreeMap<String, [Option<Vec<f64>>; 3]>,
+}
+
+/// Aligns `reference` with `trial` (the lag of [`compare`] against the
+/// trial's own angles) and resamples it onto the trial's times.
+pub fn trace(
+    trial: &Trial,
+    model: &Model,
+    reference: &Reference,
+    opts: &CompareOptions,
+) -> Result<ReferenceTrace, String> {
+    let report = compare(&[(String::new(), trial)], model, reference, opts)?;
+    let values = channels_at(reference, &trial.time_s, report.lag_s);
+    let mut joints: std::collections::BTreeMap<String, [Option<Vec<f64>>; 3]> = Default::default();
+    for (c, v) in reference.channels.iter().zip(values) {
+        joints.entry(c.joint.clone()).or_default()[c.axis.index()] = Some(v);
+    }
+    Ok(ReferenceTrace {
+        origin: reference.origin.clone(),
+        lag_s: report.lag_s,
+        joints,
+    })
+}
+
 fn score(joint: &str, axis: &str, trial: &[f64], reference: &[f64]) -> AxisScore {
     let p = pairs(trial, reference);
     let n = p.n.max(1) as f64;

@@ -10,9 +10,12 @@ mod compare;
 mod read;
 
 pub use compare::{
-    compare, format_text, AxisScore, CompareOptions, ReferenceReport, VariantScores,
+    compare, format_text, trace, AxisScore, CompareOptions, ReferenceReport, ReferenceTrace,
+    VariantScores,
 };
-pub use read::{read_reference, write_c3d, write_csv, write_mot, REFERENCE_BESIDE};
+pub use read::{
+    read_reference, reference_beside, write_c3d, write_csv, write_mot, REFERENCE_BESIDE,
+};
 
 use crate::model::Axis;
 

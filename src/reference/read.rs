@@ -21,6 +21,23 @@ use std::path::Path;
 /// A reference beside a trial that the workbench picks up: `<trial stem>.reference.{csv,mot,c3d}`.
 pub const REFERENCE_BESIDE: &str = "reference";
 
+/// The reference file beside a trial, if there is one:
+/// `<trial stem>.reference.csv`, `.mot` or `.c3d` (in that order), the stem
+/// being the trial's name without `.gz` and its format extension
+/// (`walk.csv.gz` -> `walk.reference.csv`; a folder of exports: its name).
+pub fn reference_beside(trial_path: &Path) -> Option<std::path::PathBuf> {
+    let name = trial_path.file_name()?.to_string_lossy().into_owned();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    let stem = match name.rfind('.') {
+        Some(i) if i > 0 && !trial_path.is_dir() => &name[..i],
+        _ => name,
+    };
+    ["csv", "mot", "c3d"]
+        .iter()
+        .map(|ext| trial_path.with_file_name(format!("{stem}.{REFERENCE_BESIDE}.{ext}")))
+        .find(|p| p.is_file())
+}
+
 /// Reads a reference, the format from the file name (`.csv`, `.mot`, `.c3d`).
 pub fn read_reference(path: &Path, model: &Model) -> Result<Reference, TrialError> {
     let origin = path.display().to_string();

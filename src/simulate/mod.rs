@@ -653,7 +653,8 @@ fn full_body_segments(model: &Model, seed: u64, time_s: &[f64]) -> Vec<(String, 
 }
 
 /// Segment orientations of every IMU of `model`: the base from `base`, each
-/// joint's distal segment as its proximal one times `Rzyx(angles(joint index, t))`.
+/// joint's distal segment as its proximal one times the joint rotation of
+/// `angles(joint index, t)` (degrees, the table's convention: [`crate::model::Joint::rotation`]).
 fn chain_segments(
     model: &Model,
     base: &motion::BaseMotion,
@@ -670,7 +671,7 @@ fn chain_segments(
         let dist = prox
             .iter()
             .zip(time_s)
-            .map(|(p, &t)| p * rotation::quat_from_euler_zyx_deg(angles(k, t)))
+            .map(|(p, &t)| p * j.rotation(angles(k, t)))
             .collect();
         by_imu.insert(&j.distal, dist);
     }

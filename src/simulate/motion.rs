@@ -109,7 +109,8 @@ pub(super) fn joint_motion(rng: &mut ChaCha8Rng, table: &LimitTable, joint: &Joi
         let (mut lo, mut hi) = limits.map_or((-10.0, 10.0), |l| {
             (l.range_deg[axis][0], l.range_deg[axis][1])
         });
-        if axis == 1 {
+        // The segment frames' middle (Y) angle stays clear of its singularity.
+        if joint.angle_axes[axis].axis == crate::model::Axis::Y {
             lo = lo.max(-MAX_ABS_Y_DEG);
             hi = hi.min(MAX_ABS_Y_DEG);
         }

@@ -35,7 +35,8 @@ pub fn range_deg(table: &LimitTable, joint: &Joint, axis: usize) -> [f64; 2] {
         .map_or([-10.0, 10.0], |l| l.range_deg[axis]);
     let cut = SHRINK_FRACTION * (hi - lo);
     let (mut lo, mut hi) = (lo + cut, hi - cut);
-    if axis == 1 {
+    // The segment frames' middle (Y) angle stays clear of its singularity.
+    if joint.angle_axes[axis].axis == crate::model::Axis::Y {
         lo = lo.max(-MAX_ABS_Y_DEG);
         hi = hi.min(MAX_ABS_Y_DEG);
     }

@@ -71,8 +71,8 @@ impl TruthMeta {
 }
 
 impl Truth {
-    /// True Z-Y-X angles of `joint` per sample, degrees: the Euler angles of
-    /// `G_R_segment_prox^T * G_R_segment_dist`. Empty when either IMU is missing.
+    /// True angles of `joint` per sample, degrees, in the table's convention:
+    /// [`Joint::angles`] of the true segments. Empty when either IMU is missing.
     pub fn true_joint_angles(&self, joint: &Joint) -> Vec<[f64; 3]> {
         let (Some(p), Some(d)) = (
             self.segments.imu(&joint.proximal),
@@ -83,7 +83,7 @@ impl Truth {
         p.orientation
             .iter()
             .zip(&d.orientation)
-            .map(|(p, d)| rotation::euler_zyx_deg(&(p.inverse() * d)))
+            .map(|(p, d)| joint.angles(p, d))
             .collect()
     }
 

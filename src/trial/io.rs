@@ -128,12 +128,13 @@ pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
 }
 
 /// True when `path`'s name is a trial file: it ends in `.csv`, `.sto`, `.csv.gz` or
-/// `.sto.gz` and is not a truth file (`*.truth.csv`, `*.truth.sto`, optionally `.gz`).
+/// `.sto.gz` and is not a truth file (`*.truth.csv`, `*.truth.sto`, optionally `.gz`)
+/// nor an optical reference (`*.reference.csv`).
 /// Sidecars (`.json`), backups (`.bak`), temporary files and calibration
-/// recordings (`*.calib.csv`, see [`crate::calibration::is_calibration_recording`])
+/// recordings (`*.calib.csv`, see [`crate::file_names::is_calibration_recording`])
 /// never qualify.
 pub fn is_trial_file(path: &Path) -> bool {
-    if crate::calibration::is_calibration_recording(path) {
+    if crate::file_names::is_calibration_recording(path) {
         return false;
     }
     let Some(name) = path.file_name() else {
@@ -141,7 +142,11 @@ pub fn is_trial_file(path: &Path) -> bool {
     };
     let name = name.to_string_lossy().to_ascii_lowercase();
     let stem = name.strip_suffix(".gz").unwrap_or(&name);
-    if stem.ends_with(".truth.csv") || stem.ends_with(".truth.sto") {
+    // Truths and optical references (`<trial>.reference.csv`) sit beside trials.
+    if stem.ends_with(".truth.csv")
+        || stem.ends_with(".truth.sto")
+        || stem.ends_with(".reference.csv")
+    {
         return false;
     }
     kind_of_name(path).is_some()

@@ -41,6 +41,12 @@ pub struct Loaded {
     pub truth: Option<Trial>,
     /// Why the truth beside the trial could not be used.
     pub truth_error: Option<String>,
+    /// The optical reference beside the trial (`<trial stem>.reference.csv`,
+    /// `.mot` or `.c3d`), aligned with the trial as read (lag found as
+    /// `report --reference` finds it) and resampled onto its samples.
+    pub reference: Option<Arc<crate::reference::ReferenceTrace>>,
+    /// Why the reference beside the trial could not be used.
+    pub reference_error: Option<String>,
     /// Figures of the uncorrected trial.
     pub before: Vec<JointFigures>,
     /// Joint angles of the uncorrected trial, filled on demand.

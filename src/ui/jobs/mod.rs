@@ -120,6 +120,7 @@ pub fn load_trial(
             Some(Err(e)) => (None, Some(shown(e))),
         };
         let before = trial_figures(&trial, None, truth.as_ref(), &model, limits);
+        let (reference, reference_error) = reference_beside(path, &trial, &model);
         let glitches = glitches(&trial, glitch_deg);
         let on_disk = saved_outputs(path, format.output_default(), gzip);
         Ok(Arc::new(Loaded {
@@ -131,6 +132,8 @@ pub fn load_trial(
             gzip,
             truth,
             truth_error,
+            reference,
+            reference_error,
             before,
             angles: Default::default(),
             pose: None,
@@ -138,6 +141,29 @@ pub fn load_trial(
         }))
     })();
     Msg::Loaded(file.to_string(), result)
+}
+
+/// The optical reference beside the trial at `path`, aligned and resampled
+/// onto `trial` (None, None when there is none; the reason when it is unusable).
+fn reference_beside(
+    path: &Path,
+    trial: &crate::trial::Trial,
+    model: &Model,
+) -> (
+    Option<Arc<crate::reference::ReferenceTrace>>,
+    Option<String>,
+) {
+    use crate::reference::{read_reference, trace, CompareOptions};
+    let Some(file) = crate::reference::reference_beside(path) else {
+        return (None, None);
+    };
+    let traced = read_reference(&file, model)
+        .map_err(|e| e.to_string())
+        .and_then(|r| trace(trial, model, &r, &CompareOptions::default()));
+    match traced {
+        Ok(t) => (Some(Arc::new(t)), None),
+        Err(e) => (None, Some(format!("reference: {e}"))),
+    }
 }
 
 /// The corrected outputs of `input` on disk whose sidecars record this very

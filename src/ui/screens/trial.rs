@@ -114,6 +114,8 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let (s0, s1) = app.view.span(d);
     let ci = index_at(t, app.view.cursor_s + origin);
     let glitches = crate::ui::glitches::of_joint(l, &joint.name);
+    // The optical reference beside the trial, per axis where it has one.
+    let reference = l.reference.as_ref().and_then(|r| r.joints.get(&joint.name));
     let [charts, foot] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
     let parts = Layout::vertical([Constraint::Ratio(1, 3); 3]).split(charts);
     for axis in 0..3 {
@@ -136,6 +138,11 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
                 theme.corrected,
             ));
         }
+        let ref_axis = reference.and_then(|r| r[axis].as_deref());
+        if let Some(r) = ref_axis {
+            let v = r.get(ci).copied().filter(|v| v.is_finite());
+            title.push(Span::styled(format!("ref {} ", num(v, 0)), theme.ok));
+        }
         chart(
             f,
             parts[axis],
@@ -147,6 +154,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
                 axis,
                 raw: &raw,
                 cor: cor.as_deref().map(Vec::as_slice),
+                reference: ref_axis,
                 range,
                 centroid,
                 span: (s0, s1),
@@ -180,6 +188,13 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
                 theme.warn,
             ),
             Span::styled(status, theme.dim),
+            Span::styled(
+                l.reference
+                    .as_ref()
+                    .map(|r| format!("  ref lag {:+.2} s", r.lag_s))
+                    .unwrap_or_default(),
+                theme.ok,
+            ),
             Span::styled(note.unwrap_or_default(), theme.warn),
             Span::styled(
                 crate::ui::pose::label(l)
@@ -208,6 +223,8 @@ struct ChartData<'a> {
     axis: usize,
     raw: &'a [[f64; 3]],
     cor: Option<&'a [[f64; 3]]>,
+    /// The optical reference's angle of this axis per sample (NaN: none).
+    reference: Option<&'a [f64]>,
     range: Option<[f64; 2]>,
     centroid: Option<f64>,
     span: (f64, f64),
@@ -230,10 +247,17 @@ fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
         .cor
         .map(|c| envelope(d.t, d.origin, |i| c[i][d.axis], s0, s1, cols * per_col))
         .unwrap_or_default();
+    let reference: Vec<(f64, f64)> = d
+        .reference
+        .map(|r| envelope(d.t, d.origin, |i| r[i], s0, s1, cols * per_col))
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|(_, y)| y.is_finite())
+        .collect();
     // Bounds: the data in view and the limits.
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
-    for &(_, y) in raw.iter().chain(cor.iter()) {
+    for &(_, y) in raw.iter().chain(cor.iter()).chain(reference.iter()) {
         lo = lo.min(y);
         hi = hi.max(y);
     }
@@ -274,6 +298,22 @@ fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
     sets.push(line(&raw, theme.raw, marker));
     if !cor.is_empty() {
         sets.push(line(&cor, theme.corrected, marker));
+    }
+    // The reference as points of the other marker (named `ref` in the title),
+    // so it reads apart from raw and corrected without colour.
+    if !reference.is_empty() {
+        let other = if d.braille {
+            Marker::Dot
+        } else {
+            Marker::Braille
+        };
+        sets.push(
+            Dataset::default()
+                .data(&reference)
+                .graph_type(GraphType::Scatter)
+                .marker(other)
+                .style(theme.ok),
+        );
     }
     // Glitches last, as full blocks: a glyph of their own, not colour alone.
     if !d.glitches.is_empty() {
@@ -463,4 +503,64 @@ pub fn zoom(app: &mut Workbench, zoom_in: bool) {
     }
     let w = d / f64::from(1u32 << app.view.zoom);
     app.view.start_s = (centre - w / 2.0).clamp(0.0, (d - w).max(0.0));
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::reference::write_csv;
+    use crate::simulate::{preset, simulate};
+    use crate::trial::{write_trial, TrialFormat};
+    use crate::ui::headless::{buffer_text, draw, load_app, show, Show};
+    use crate::ui::theme::Theme;
+
+    /// A 20 s knee trial with its truth written beside it as an optical
+    /// reference (`knee.reference.csv`) whose clock runs 0.4 s ahead: the
+    /// trial screen draws it with its own marker, names it and its lag.
+    #[test]
+    fn the_reference_beside_a_trial_is_drawn_on_the_trial_screen() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().join("trials");
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut cfg = preset("knee_calf_z15").unwrap();
+        cfg.duration_s = 20.0;
+        let sim = simulate(&cfg).unwrap();
+        write_trial(&sim.trial, &dir.join("knee.csv"), TrialFormat::QuatCsv).unwrap();
+        let knee = crate::model::Model::infant13();
+        let knee = knee.joint("l_knee").unwrap();
+        let truth = sim.truth.true_joint_angles(knee);
+        let time: Vec<f64> = sim.trial.time_s.iter().map(|t| t + 0.4).collect();
+        let columns: Vec<(String, Vec<f64>)> = ["x", "y", "z"]
+            .iter()
+            .enumerate()
+            .map(|(k, a)| (format!("l_knee_{a}"), truth.iter().map(|v| v[k]).collect()))
+            .collect();
+        write_csv(&dir.join("knee.reference.csv"), &time, &columns).unwrap();
+        let mut app = load_app("trials", &dir, &tmp.path().join("joint_limits")).unwrap();
+        // The reference is not listed as a trial.
+        assert_eq!(app.trials.len(), 1);
+        show(
+            &mut app,
+            &Show {
+                screen: "trial".into(),
+                trial: Some("knee.csv".into()),
+                ..Show::default()
+            },
+        )
+        .unwrap();
+        let l = app.trials[0].loaded().unwrap();
+        let r = l.reference.as_ref().expect("reference read");
+        assert!((r.lag_s - 0.4).abs() < 1e-9, "{}", r.lag_s);
+        // At the cursor the reference reads the truth (the titles show it).
+        app.wb.view.cursor_s = 5.0;
+        for (w, h) in crate::ui::tests::SIZES {
+            let text = buffer_text(&draw(&app, &Theme::default(), w, h));
+            // The footer names the lag where it has room.
+            assert!(w < 120 || text.contains("ref lag +0.40 s"), "{text}");
+            // Named in each chart's title, drawn with the other marker.
+            let named = text.matches(" ref ").count() - text.matches(" ref lag").count();
+            assert_eq!(named, 3, "{text}");
+            assert!(text.contains('•'), "{text}");
+            insta::assert_snapshot!(format!("trial_reference_{w}x{h}"), text);
+        }
+    }
 }

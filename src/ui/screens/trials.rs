@@ -132,6 +132,15 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
                     if let Some(m) = &l.truth_error {
                         text.push(Line::from(Span::styled(format!("truth: {m}"), theme.warn)));
                     }
+                    if let Some(r) = &l.reference {
+                        text.push(Line::from(format!(
+                            "optical reference beside the trial (lag {:+.2} s): drawn on the trial screen",
+                            r.lag_s
+                        )));
+                    }
+                    if let Some(m) = &l.reference_error {
+                        text.push(Line::from(Span::styled(m.clone(), theme.warn)));
+                    }
                     for w in &l.trial.warnings {
                         text.push(Line::from(Span::styled(w.clone(), theme.warn)));
                     }

@@ -1,0 +1,454 @@
+//! Joint angles come out in the limit table's convention after a pose
+//! calibration, for every built-in model (docs/method.md section 2.5).
+//!
+//! The truth here is physical, not a set of Euler angles: a body holds its
+//! model's calibration pose, then one joint moves by a known angle in a known
+//! anatomical sense (the thigh swings forward, the shank folds back, the arm
+//! rises forward, ...), each defined from the pose's directions (forward,
+//! left, up) and the segments' directions, never from the model's own axes.
+//! The IMUs sit on their segments at random orientations (the base with its
+//! `pose.base_forward` axis forward, as pose calibration needs) and the subject
+//! faces a random heading. After pose calibration the joint's angle on the
+//! table's axis for that movement must equal the imposed angle, positive in
+//! the sense the table counts positive (Table 3-3: flexion, external rotation,
+//! abduction, plantar flexion, left rotation and left lateral bending of the
+//! trunk), and the other two axes must stay 0.
+
+use acm_workbench::acm::RunControl;
+use acm_workbench::limits::{LimitTable, Settings};
+use acm_workbench::metrics::joint_angles;
+use acm_workbench::model::{Joint, Model, BUILTIN_MODELS};
+use acm_workbench::pose::convention::check_conventions;
+use acm_workbench::pose::{calibrate, PoseCalibration, PoseTime};
+use acm_workbench::rotation::{quat_axis_angle_deg, Quat};
+use acm_workbench::trial::{ImuSeries, Trial};
+use nalgebra::{UnitQuaternion, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::BTreeMap;
+
+type V = Vector3<f64>;
+
+/// A joint that moves: its name, the pose-frame axis and the angle (degrees) over time.
+type Moving<'a> = (&'a str, V, &'a dyn Fn(f64) -> f64);
+
+/// The calibration pose of a model, in the frame the calibration gives the
+/// segments (forward = +x after the heading correction, up = +z).
+struct PoseGeometry {
+    /// Where the subject faces (the ventral side).
+    forward: V,
+    /// The subject's left.
+    left: V,
+    /// Up (the vertical).
+    up: V,
+}
+
+const STANDING: PoseGeometry = PoseGeometry {
+    forward: V::new(1.0, 0.0, 0.0),
+    left: V::new(0.0, 1.0, 0.0),
+    up: V::new(0.0, 0.0, 1.0),
+};
+
+/// One anatomical movement of one joint: the table axis it is counted on
+/// (0 = X) and the axis (pose frame) the distal segment turns about by a
+/// positive angle of it, from the definitions of the movements.
+struct Movement {
+    name: &'static str,
+    table_axis: usize,
+    axis: V,
+}
+
+/// The movements of a joint in the standing pose (arms hanging, palms towards
+/// the thighs), by the joint's kind and side.
+fn standing_movements(joint: &Joint) -> Vec<Movement> {
+    let g = &STANDING;
+    let down = -g.up;
+    let right = joint.name.starts_with("r_");
+    let lateral = if right { -g.left } else { g.left };
+    let medial = -lateral;
+    // Turning `from` towards `to` is a positive turn about `from x to`.
+    let towards = |from: V, to: V| from.cross(&to).normalize();
+    let m = |name, table_axis, axis| Movement {
+        name,
+        table_axis,
+        axis,
+    };
+    match joint.kind.as_str() {
+        "back" | "neck" | "lumbar" | "thoracic" => vec![
+            m("left rotation", 0, towards(g.forward, g.left)),
+            m("flexion", 1, towards(g.up, g.forward)),
+            m("left lateral bending", 2, towards(g.up, g.left)),
+        ],
+        "hip" => vec![
+            m("external rotation", 0, towards(g.forward, lateral)),
+            m("flexion", 1, towards(down, g.forward)),
+            m("abduction", 2, towards(down, lateral)),
+        ],
+        "knee" => vec![
+            m("lateral rotation", 0, towards(g.forward, lateral)),
+            m("flexion", 1, towards(down, -g.forward)),
+            m("abduction", 2, towards(down, lateral)),
+        ],
+        "ankle" => vec![
+            m("lateral rotation", 0, towards(g.forward, lateral)),
+            m("plantar flexion", 1, towards(g.forward, down)),
+            m("eversion", 2, towards(down, lateral)),
+        ],
+        "shoulder" => vec![
+            m("flexion", 0, towards(down, g.forward)),
+            m("external rotation", 1, towards(g.forward, lateral)),
+            m("abduction", 2, towards(down, lateral)),
+        ],
+        "elbow" => vec![
+            m("flexion", 0, towards(down, g.forward)),
+            m("abduction", 1, towards(down, lateral)),
+            m("pronation", 2, towards(g.forward, medial)),
+        ],
+        "wrist" => vec![
+            // Palms towards the thighs: flexion turns the hand medially.
+            m("flexion", 0, towards(down, medial)),
+            m("ulnar deviation", 1, towards(down, -g.forward)),
+            m("rotation", 2, towards(medial, -g.forward)),
+        ],
+        other => panic!("no movements for joint kind {other}"),
+    }
+}
+
+/// The joint's angle over time, degrees: still for 1 s (the pose), then a
+/// swing between 0 and `peak`.
+fn swing(t: f64, peak: f64) -> f64 {
+    if t < 1.0 {
+        0.0
+    } else {
+        0.5 * peak * (1.0 - (2.0 * (t - 1.0)).cos())
+    }
+}
+
+/// Sensor-to-segment mountings: random, except the base's `base_forward`
+/// axis points forward (its turn about forward is random).
+fn mountings(model: &Model, rng: &mut ChaCha8Rng) -> BTreeMap<String, Quat> {
+    let mut random = || {
+        let v = V::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        (
+            UnitQuaternion::from_scaled_axis(v * 2.0),
+            rng.random_range(-180.0..180.0),
+        )
+    };
+    model
+        .imus
+        .iter()
+        .map(|imu| {
+            let (m, roll) = random();
+            let m = if *imu == model.base {
+                let bf = V::from(model.pose.base_forward.vector());
+                let onto_x = UnitQuaternion::rotation_between(&bf, &V::x())
+                    .unwrap_or_else(|| quat_axis_angle_deg([0.0, 0.0, 1.0], 180.0));
+                quat_axis_angle_deg([1.0, 0.0, 0.0], roll) * onto_x
+            } else {
+                m
+            };
+            (imu.clone(), m)
+        })
+        .collect()
+}
+
+/// A trial of `model` in which every joint of `moving` turns its distal
+/// segment (and all below it) about `axis` (pose frame) by `angle(t)`;
+/// sensors on their segments by `mount`, the subject facing `heading_deg`.
+fn physical_trial(
+    model: &Model,
+    moving: &[Moving],
+    mount: &BTreeMap<String, Quat>,
+    heading_deg: f64,
+) -> Trial {
+    let time_s: Vec<f64> = (0..400).map(|i| f64::from(i) / 50.0).collect();
+    let heading = quat_axis_angle_deg([0.0, 0.0, 1.0], heading_deg);
+    let mut seg: BTreeMap<&str, Vec<Quat>> = BTreeMap::new();
+    seg.insert(&model.base, vec![Quat::identity(); time_s.len()]);
+    for j in &model.joints {
+        let parent = seg[j.proximal.as_str()].clone();
+        let turn = moving.iter().find(|(n, _, _)| *n == j.name);
+        let own: Vec<Quat> = parent
+            .iter()
+            .zip(&time_s)
+            .map(|(p, &t)| match turn {
+                // The turn about a pose-frame axis, made in the proximal
+                // segment (identity in the pose), carried by the parent.
+                Some((_, axis, angle)) => {
+                    p * UnitQuaternion::from_scaled_axis(axis * angle(t).to_radians())
+                }
+                None => *p,
+            })
+            .collect();
+        seg.insert(&j.distal, own);
+    }
+    let imus = model
+        .imus
+        .iter()
+        .map(|name| {
+            let m = mount[name];
+            let q = seg[name.as_str()].iter().map(|s| heading * s * m).collect();
+            ImuSeries::new(name.clone(), q)
+        })
+        .collect();
+    Trial {
+        name: format!("{} physical", model.name),
+        imus,
+        time_s,
+        warnings: vec![],
+    }
+}
+
+fn calibrated(trial: &Trial, model: &Model) -> Trial {
+    let cal = PoseCalibration {
+        at: PoseTime::Span(0.0, 0.5),
+        setup: model.pose,
+    };
+    calibrate(trial, model, &cal).unwrap().0
+}
+
+/// The standing models: every movement of every joint, alone, reads as
+/// itself on its table axis, positive, the other axes 0.
+#[test]
+fn every_movement_of_every_standing_model_reads_positive_on_its_table_axis() {
+    let mut rng = ChaCha8Rng::seed_from_u64(15);
+    let mut checked = 0;
+    for name in ["opensense_lower", "opensim", "full_body16"] {
+        let model = Model::builtin(name).unwrap();
+        let mount = mountings(&model, &mut rng);
+        for joint in &model.joints {
+            for mv in standing_movements(joint) {
+                let peak = 40.0;
+                let angle = |t: f64| swing(t, peak);
+                let heading = rng.random_range(-180.0..180.0);
+                let trial =
+                    physical_trial(&model, &[(&joint.name, mv.axis, &angle)], &mount, heading);
+                let cal = calibrated(&trial, &model);
+                let a = joint_angles(&cal, joint).unwrap();
+                for (i, (x, &t)) in a.iter().zip(&cal.time_s).enumerate() {
+                    for k in 0..3 {
+                        let want = if k == mv.table_axis { angle(t) } else { 0.0 };
+                        assert!(
+                            (x[k] - want).abs() < 1e-6,
+                            "{name} {} {}: sample {i}, axis {k}: {:.6} deg, want {want:.6} (all {x:?})",
+                            joint.name,
+                            mv.name,
+                            x[k]
+                        );
+                    }
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 3 * (7 + 11 + 15));
+}
+
+/// Gait on the standing models: hips and knees flexing (and the ankles
+/// plantar flexing) as walking does; the convention check is silent on it and
+/// names the joint of a mirrored copy.
+#[test]
+fn gait_passes_the_convention_check_and_a_mirrored_hip_is_named() {
+    let table = LimitTable::default_table();
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let hip = |t: f64| {
+        if t < 1.0 {
+            0.0
+        } else {
+            10.0 - 10.0 * (4.0 * (t - 1.0)).cos() + 5.0 * (4.0 * (t - 1.0)).sin()
+        }
+    };
+    let knee = |t: f64| swing(t, 60.0);
+    let ankle = |t: f64| swing(t, 15.0);
+    let hyperextended = |t: f64| -hip(t);
+    for name in ["opensense_lower", "opensim", "full_body16"] {
+        let model = Model::builtin(name).unwrap();
+        let mount = mountings(&model, &mut rng);
+        let flexion = |j: &str| {
+            let joint = model.joint(j).unwrap();
+            let mv = standing_movements(joint);
+            mv[1].axis
+        };
+        let gait: Vec<Moving> = vec![
+            ("l_hip", flexion("l_hip"), &hip),
+            ("r_hip", flexion("r_hip"), &hip),
+            ("l_knee", flexion("l_knee"), &knee),
+            ("r_knee", flexion("r_knee"), &knee),
+            ("l_ankle", flexion("l_ankle"), &ankle),
+            ("r_ankle", flexion("r_ankle"), &ankle),
+        ];
+        let cal = calibrated(&physical_trial(&model, &gait, &mount, 70.0), &model);
+        let w = check_conventions(&cal, &model, &table, true);
+        assert!(w.is_empty(), "{name}: {w:?}");
+        for j in ["l_hip", "r_hip", "l_knee", "r_knee"] {
+            let a = joint_angles(&cal, model.joint(j).unwrap()).unwrap();
+            let max = a.iter().map(|x| x[1]).fold(f64::MIN, f64::max);
+            let min = a.iter().map(|x| x[1]).fold(f64::MAX, f64::min);
+            assert!(max > 19.0 && min > -1.2, "{name} {j}: Y {min}..{max}");
+        }
+        let mut mirrored = gait;
+        mirrored[1] = ("r_hip", flexion("r_hip"), &hyperextended);
+        let cal = calibrated(&physical_trial(&model, &mirrored, &mount, 70.0), &model);
+        let w = check_conventions(&cal, &model, &table, true);
+        assert!(
+            w.len() == 1 && w[0].starts_with("r_hip y:") && w[0].contains("mirrored"),
+            "{name}: {w:?}"
+        );
+    }
+}
+
+/// Every variant keeps the table's sense: on the calibrated gait of
+/// `opensense_lower` with the thigh and shank sensors turned on their
+/// segments after the pose (so the variants have something to correct), the
+/// corrected hip and knee flexion follow the true flexion (correlation above
+/// 0.9) and stay positive on average.
+#[test]
+fn every_variant_reports_flexion_positive() {
+    use acm_workbench::acm::Variant;
+    use acm_workbench::correct::correct_trial;
+    let model = Model::builtin("opensense_lower").unwrap();
+    let table = LimitTable::default_table();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mount = mountings(&model, &mut rng);
+    let hip = |t: f64| swing(t, 40.0) - 10.0;
+    let knee = |t: f64| swing(t, 60.0);
+    let flexion = |j: &str| standing_movements(model.joint(j).unwrap())[1].axis;
+    let gait: Vec<Moving> = vec![
+        ("l_hip", flexion("l_hip"), &hip),
+        ("r_hip", flexion("r_hip"), &hip),
+        ("l_knee", flexion("l_knee"), &knee),
+        ("r_knee", flexion("r_knee"), &knee),
+    ];
+    let truth = calibrated(&physical_trial(&model, &gait, &mount, 20.0), &model);
+    let mut trial = truth.clone();
+    // A 10 deg slip of each thigh and shank sensor about its segment's long axis.
+    for imu in ["femur_l_imu", "femur_r_imu", "tibia_l_imu", "tibia_r_imu"] {
+        let s = quat_axis_angle_deg([0.0, 0.0, 1.0], 10.0);
+        for q in &mut trial
+            .imus
+            .iter_mut()
+            .find(|i| i.name == imu)
+            .unwrap()
+            .orientation
+        {
+            *q *= s;
+        }
+    }
+    let settings = Settings {
+        window_s: 4.0,
+        hop_s: 2.0,
+        ..Settings::default()
+    };
+    for variant in Variant::ALL {
+        let c = correct_trial(
+            &trial,
+            &model,
+            &table,
+            &settings,
+            variant,
+            &RunControl::default(),
+        )
+        .unwrap();
+        for j in ["l_hip", "r_hip", "l_knee", "r_knee"] {
+            let joint = model.joint(j).unwrap();
+            let got: Vec<f64> = joint_angles(&c.corrected, joint)
+                .unwrap()
+                .iter()
+                .map(|a| a[1])
+                .collect();
+            let want: Vec<f64> = joint_angles(&truth, joint)
+                .unwrap()
+                .iter()
+                .map(|a| a[1])
+                .collect();
+            let r = correlation(&got, &want);
+            let mean = got.iter().sum::<f64>() / got.len() as f64;
+            assert!(
+                r > 0.9 && mean > 0.0,
+                "{variant} {j}: r {r:.3}, mean {mean:.2}"
+            );
+        }
+    }
+}
+
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+    cov / (va * vb).sqrt()
+}
+
+/// Every standing model declares its joints' angle axes (none is left to
+/// the default by accident). `infant13` keeps the thesis' frames (the
+/// default), in which its sample trials and Table 3-2 were made.
+#[test]
+fn every_standing_model_states_its_angle_axes() {
+    for (name, text) in BUILTIN_MODELS {
+        let model = Model::builtin(name).unwrap();
+        let joints = text.matches("[[joint]]").count();
+        let declared = text.matches("\nangle_axes = ").count();
+        assert_eq!(model.joints.len(), joints);
+        let want = if *name == "infant13" { 0 } else { joints };
+        assert_eq!(declared, want, "{name}");
+    }
+}
+
+/// The shared folder of public recordings, if this checkout sits beside it
+/// (`ACMW_REAL_DATA` names it elsewhere).
+fn real_data() -> Option<std::path::PathBuf> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::env::var_os("ACMW_REAL_DATA")
+        .map(std::path::PathBuf::from)
+        .into_iter()
+        .chain([
+            root.join("../shared/real_data"),
+            root.join("../../shared/real_data"),
+        ])
+        .find(|p| p.join("opensense_example/myIMUMappings.xml").is_file())
+}
+
+/// The OpenSense example's walking trial (Xsens MTw, 100 Hz) after pose
+/// calibration on its first second (standing): hips and knees flex positive,
+/// and the convention check is silent. Skips when the recording is absent.
+#[test]
+fn opensense_walking_flexes_hips_and_knees_positive() {
+    let Some(dir) = real_data() else {
+        eprintln!("skipped: no shared real_data folder beside the checkout");
+        return;
+    };
+    let model = Model::builtin("opensense_lower").unwrap();
+    let path = dir.join("opensense_example/myIMUMappings.xml");
+    let trial = acm_workbench::trial::read_trial(&path, &model).unwrap();
+    let cal = PoseCalibration {
+        at: PoseTime::Span(0.0, 1.0),
+        setup: model.pose,
+    };
+    let cal = calibrate(&trial, &model, &cal).unwrap().0;
+    let w = check_conventions(&cal, &model, &LimitTable::default_table(), true);
+    assert!(w.is_empty(), "{w:?}");
+    for j in ["l_hip", "r_hip", "l_knee", "r_knee", "l_ankle", "r_ankle"] {
+        let y: Vec<f64> = joint_angles(&cal, model.joint(j).unwrap())
+            .unwrap()
+            .iter()
+            .map(|a| a[1])
+            .collect();
+        let mean = y.iter().sum::<f64>() / y.len() as f64;
+        let (min, max) = y
+            .iter()
+            .fold((f64::MAX, f64::MIN), |m, &v| (m.0.min(v), m.1.max(v)));
+        eprintln!("{j} y: mean {mean:.1}, range {min:.1} .. {max:.1}");
+        if j.ends_with("hip") || j.ends_with("knee") {
+            // Walking flexes both by 20 deg and more, never as far the other way.
+            assert!(
+                mean > 0.0 && max > 20.0 && max > -2.0 * min,
+                "{j}: {mean} {min}..{max}"
+            );
+        }
+    }
+}
