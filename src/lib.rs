@@ -10,6 +10,7 @@
 pub mod acm;
 pub mod analysis;
 pub mod baselines;
+pub mod batch;
 pub mod calibration;
 pub mod correct;
 pub mod file_names;

@@ -41,8 +41,39 @@ impl WriteError {
     }
 }
 
-/// Prefix of every temporary file a save makes (`.acmw-<pid>-<random>.tmp`).
+/// Prefix of every temporary file a save makes
+/// (`.acmw-<pid>.<host>-<random>.tmp`).
 const TMP_PREFIX: &str = ".acmw-";
+
+/// The writer part of this process's temporary files: `<pid>.<host>`. The
+/// host keeps a save from removing, as a dead writer's, the temporary of a
+/// process on another machine writing to the same shared folder.
+fn temp_owner_tag() -> &'static str {
+    static TAG: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TAG.get_or_init(|| format!("{}.{}", std::process::id(), host_tag()))
+}
+
+/// This machine's name, letters and digits only, at most 32 of them.
+fn host_tag() -> String {
+    #[cfg(unix)]
+    {
+        let mut buf = [0u8; 256];
+        // SAFETY: the buffer is writable for its length; the name is cut at its NUL.
+        let r = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) };
+        if r == 0 {
+            let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
+            let tag: String = String::from_utf8_lossy(&buf[..end])
+                .chars()
+                .filter(char::is_ascii_alphanumeric)
+                .take(32)
+                .collect();
+            if !tag.is_empty() {
+                return tag;
+            }
+        }
+    }
+    "localhost".into()
+}
 
 /// Name of the journal of a multi-file save in its folder.
 const JOURNAL: &str = ".acmw-commit.json";
@@ -184,7 +215,7 @@ pub fn recover(dir: &Path) -> io::Result<()> {
 /// permissions of `target` (or the usual ones for a new file).
 fn write_temp(dir: &Path, bytes: &[u8], target: &Path) -> io::Result<tempfile::NamedTempFile> {
     let mut tmp = tempfile::Builder::new()
-        .prefix(&format!("{TMP_PREFIX}{}-", std::process::id()))
+        .prefix(&format!("{TMP_PREFIX}{}-", temp_owner_tag()))
         .suffix(".tmp")
         .tempfile_in(dir)?;
     tmp.write_all(bytes)?;
@@ -213,7 +244,7 @@ fn keep_backup(path: &Path, dir: &Path) -> io::Result<()> {
         return Ok(());
     }
     let name = tempfile::Builder::new()
-        .prefix(&format!("{TMP_PREFIX}{}-", std::process::id()))
+        .prefix(&format!("{TMP_PREFIX}{}-", temp_owner_tag()))
         .suffix(".tmp")
         .make_in(dir, |p| fs::hard_link(path, p));
     match name {
@@ -269,10 +300,16 @@ fn journal_temps(dir: &Path) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// The process id in a temporary file's name `.acmw-<pid>-<random>.tmp`.
+/// The process id in a temporary file's name `.acmw-<pid>[.<host>]-<random>.tmp`,
+/// when that process ran on this machine (or the name records no machine).
 fn temp_owner(name: &str) -> Option<u32> {
     let rest = name.strip_prefix(TMP_PREFIX)?.strip_suffix(".tmp")?;
-    rest.split_once('-')?.0.parse().ok()
+    let owner = rest.split_once('-')?.0;
+    match owner.split_once('.') {
+        Some((pid, host)) if host == host_tag() => pid.parse().ok(),
+        Some(_) => None,
+        None => owner.parse().ok(),
+    }
 }
 
 #[cfg(unix)]
@@ -390,11 +427,18 @@ mod tests {
             .path()
             .join(format!(".acmw-{}-abc.tmp", std::process::id()));
         let other = dir.path().join("notes.tmp");
-        for p in [&dead, &mine, &other] {
+        // A dead writer of this machine, and one of another machine sharing
+        // the folder (whose process this machine cannot see).
+        let dead_here = dir
+            .path()
+            .join(format!(".acmw-4000000000.{}-abc.tmp", host_tag()));
+        let elsewhere = dir.path().join(".acmw-4000000000.othermachine1-abc.tmp");
+        for p in [&dead, &mine, &other, &dead_here, &elsewhere] {
             fs::write(p, b"x").unwrap();
         }
         atomic_write(&dir.path().join("t.csv"), b"one").unwrap();
         assert!(!dead.exists() && mine.exists() && other.exists());
+        assert!(!dead_here.exists() && elsewhere.exists());
     }
 
     #[test]

@@ -26,6 +26,7 @@ macro_rules! out {
 }
 
 mod analysis;
+mod batch;
 mod calibrate;
 mod common;
 mod correct;
@@ -77,6 +78,9 @@ pub struct Cli {
 pub enum Command {
     /// Correct a trial and write the corrected trial plus a sidecar JSON.
     Correct(correct::CorrectArgs),
+    /// Correct every trial of folders or patterns into one folder, with a
+    /// resumable manifest; shards for clusters.
+    Batch(batch::BatchArgs),
     /// Print the figures (docs/method.md section 16) before and after each variant.
     Report(report::ReportArgs),
     /// Simulate a trial with known misalignment and drift, and write its truth beside it.
@@ -98,6 +102,7 @@ pub enum Command {
 pub fn run(cli: Cli) -> i32 {
     let result = match cli.command {
         Some(Command::Correct(a)) => correct::run(a),
+        Some(Command::Batch(a)) => batch::run(a),
         Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
         Some(Command::Render(a)) => render::run(a, &cli.theme),
