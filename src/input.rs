@@ -5,6 +5,8 @@
 //! The cap is [`DEFAULT_MAX_INPUT_MB`] megabytes (2^20 bytes) unless the
 //! environment variable [`MAX_INPUT_ENV`] sets another number of megabytes.
 
+pub mod locate;
+
 use std::fs::File;
 use std::io::{self, Read};
 use std::path::Path;
@@ -172,6 +174,18 @@ pub fn line_naming(text: &str, message: &str) -> Option<u64> {
     text.lines()
         .position(|l| l.contains(&needle))
         .map(|i| i as u64 + 1)
+}
+
+/// `file:line:column: message`, the form of every located error; the column
+/// is left out when it is 0 (a whole line is meant) and line and column when
+/// the line is 0 (the file as a whole is meant): no error shows a `:0:0` that
+/// points nowhere.
+pub fn located(file: &str, line: &u64, column: &usize, message: &str) -> String {
+    match (*line, *column) {
+        (0, _) => format!("{file}: {message}"),
+        (l, 0) => format!("{file}:{l}: {message}"),
+        (l, c) => format!("{file}:{l}:{c}: {message}"),
+    }
 }
 
 /// 1-based line and column (in characters) of a byte offset in `text`.

@@ -3,7 +3,7 @@
 
 /// A problem with a calibration file: where it is and what was expected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{column}: {message}")]
+#[error("{}", crate::input::located(.file, .line, .column, .message))]
 pub struct CalibrationError {
     /// The file as the user named it (or `<built-in NAME>`).
     pub file: String,

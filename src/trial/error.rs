@@ -2,7 +2,7 @@
 
 /// A problem with a trial file: where it is and what was expected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{column}: {message}")]
+#[error("{}", crate::input::located(.file, .line, .column, .message))]
 pub struct TrialError {
     /// The file as the user named it.
     pub file: String,
