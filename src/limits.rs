@@ -193,8 +193,10 @@ impl SettingsFile {
     /// TOML text for saving.
     pub fn to_toml(&self) -> String {
         format!(
-            "# Correction settings (docs/method.md sections 4-7); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n",
-            self.table, self.lambda1, self.window_s, self.hop_s, self.vertical.name(), self.glitch_deg
+            "# Correction settings (docs/method.md sections 4-7); the limit table is a CSV in this folder.\ntable = {}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n",
+            // A TOML string (Rust's `{:?}` escapes control characters as `\u{1b}`, not TOML).
+            toml::Value::String(self.table.clone()),
+            self.lambda1, self.window_s, self.hop_s, self.vertical.name(), self.glitch_deg
         )
     }
 }
