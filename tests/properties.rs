@@ -639,3 +639,20 @@ fn the_seeds_are_valid() {
     parse_export(&seeds()[3].1, "x.txt").unwrap();
     parse_mapping(&seeds()[4].1, "m.xml").unwrap();
 }
+
+/// What the properties found, kept as fixed cases: a table name with a
+/// control character (written with Rust's `\u{1b}` escape, not TOML's), and a
+/// 17-digit float that serde_json's default parser read one ulp off.
+#[test]
+fn regressions_found_by_the_properties() {
+    let s = SettingsFile {
+        table: "\u{1b}t\u{7f}.csv".into(),
+        ..SettingsFile::parse(acm_workbench::limits::BUILTIN_SETTINGS, "s").unwrap()
+    };
+    assert_eq!(SettingsFile::parse(&s.to_toml(), "s.toml").unwrap(), s);
+    let mut m = Model::infant13();
+    m.segment_direction
+        .insert("base".into(), [0.44317299437524277, 1e-6, -0.0]);
+    let back: Model = serde_json::from_str(&serde_json::to_string_pretty(&m).unwrap()).unwrap();
+    assert_eq!(back, m);
+}
