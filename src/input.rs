@@ -5,6 +5,8 @@
 //! The cap is [`DEFAULT_MAX_INPUT_MB`] megabytes (2^20 bytes) unless the
 //! environment variable [`MAX_INPUT_ENV`] sets another number of megabytes.
 
+pub mod locate;
+
 use std::fs::File;
 use std::io::{self, Read};
 use std::path::Path;

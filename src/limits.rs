@@ -173,25 +173,22 @@ impl SettingsFile {
                 message: e.message().to_string(),
             }
         })?;
-        let located = |mut e: LimitsError| {
-            let key = e.message.split_whitespace().next().unwrap_or("");
-            e.line = key_line(text, key);
-            e.column = 1;
-            e
-        };
-        s.settings().validate(origin).map_err(located)?;
-        if !(s.glitch_deg.is_finite() && s.glitch_deg > 0.0 && s.glitch_deg <= 180.0) {
-            return Err(located(LimitsError {
-                file: origin.into(),
-                line: 0,
-                column: 0,
-                message: format!(
-                    "glitch_deg must be a number of degrees in (0, 180], found {}",
-                    s.glitch_deg
-                ),
-            }));
+        match s.problem() {
+            None => Ok(s),
+            Some(p) => Err(p.in_toml(text, origin)),
         }
-        Ok(s)
+    }
+
+    /// The first value out of bounds, if any: [`Settings::problem`], then
+    /// `glitch_deg` in (0, 180] degrees.
+    pub fn problem(&self) -> Option<SettingsProblem> {
+        self.settings().problem().or_else(|| {
+            let g = self.glitch_deg;
+            (!(g.is_finite() && g > 0.0 && g <= 180.0)).then(|| SettingsProblem {
+                key: "glitch_deg",
+                message: format!("expected a number of degrees in (0, 180], found {g}"),
+            })
+        })
     }
 
     /// The correction settings it holds.
@@ -208,8 +205,10 @@ impl SettingsFile {
     /// TOML text for saving.
     pub fn to_toml(&self) -> String {
         format!(
-            "# Correction settings (docs/method.md sections 4-7); the limit table is a CSV in this folder.\ntable = {:?}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n",
-            self.table, self.lambda1, self.window_s, self.hop_s, self.vertical.name(), self.glitch_deg
+            "# Correction settings (docs/method.md sections 4-7); the limit table is a CSV in this folder.\ntable = {}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n",
+            // A TOML string (Rust's `{:?}` escapes control characters as `\u{1b}`, not TOML).
+            toml::Value::String(self.table.clone()),
+            self.lambda1, self.window_s, self.hop_s, self.vertical.name(), self.glitch_deg
         )
     }
 }
@@ -254,10 +253,12 @@ impl LimitsDir {
             if let (None, Some(text)) = (builtin, &text) {
                 // A table the lab named but that is nowhere: a typo must not
                 // silently correct with another table.
+                let (line, column) = crate::input::locate::toml_key(text, &["table"])
+                    .unwrap_or((key_line(text, "table"), 0));
                 return Err(LimitsError {
                     file: origin,
-                    line: key_line(text, "table"),
-                    column: 1,
+                    line,
+                    column,
                     message: format!(
                         "expected a limit table in {} or a built-in one, found no '{}'",
                         dir.display(),
@@ -284,39 +285,81 @@ fn line_col(text: &str, offset: usize) -> (u64, usize) {
     (line, col)
 }
 
+/// A setting out of bounds: which key, and what was expected and found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SettingsProblem {
+    /// The key as `settings.toml` and sidecars spell it (`hop_s`).
+    pub key: &'static str,
+    /// `expected ..., found ...`.
+    pub message: String,
+}
+
+impl SettingsProblem {
+    /// The error in a settings TOML `text` read from `origin`, at the key's
+    /// line and column (line 1 when the key is absent: a default is at fault).
+    pub fn in_toml(&self, text: &str, origin: &str) -> LimitsError {
+        let (line, column) = crate::input::locate::toml_key(text, &[self.key])
+            .unwrap_or((key_line(text, self.key), 0));
+        self.at(origin, line, column)
+    }
+
+    /// The error at a place in `file` (`key: message`).
+    pub fn at(&self, file: &str, line: u64, column: usize) -> LimitsError {
+        LimitsError {
+            file: file.into(),
+            line,
+            column,
+            message: format!("{}: {}", self.key, self.message),
+        }
+    }
+}
+
 impl Settings {
-    /// Checks the values are usable, wherever they came from (a settings
-    /// file, flags, a sidecar): finite, `0 <= lambda1 <= MAX_LAMBDA1`,
-    /// `0 < window_s <= MAX_SPAN_S` and `window_s / MAX_OVERLAP <= hop_s <= window_s`.
-    /// Whether the windows suit a given trial is [`crate::acm::window::check_layout`]'s.
-    pub fn validate(&self, origin: &str) -> Result<(), LimitsError> {
+    /// The first value that is not usable, wherever it came from (a settings
+    /// file, flags, a sidecar): each must be finite, with
+    /// `0 <= lambda1 <= MAX_LAMBDA1`, `0 < window_s <= MAX_SPAN_S` and
+    /// `window_s / MAX_OVERLAP <= hop_s <= window_s`. Whether the windows suit
+    /// a given trial is [`crate::acm::window::check_layout`]'s.
+    pub fn problem(&self) -> Option<SettingsProblem> {
         use crate::trial::timing::MAX_SPAN_S;
-        let err = |message: String| LimitsError {
-            file: origin.into(),
-            line: 0,
-            column: 0,
-            message,
-        };
+        let problem = |key, message| Some(SettingsProblem { key, message });
         if !(self.lambda1.is_finite() && (0.0..=MAX_LAMBDA1).contains(&self.lambda1)) {
-            return Err(err(format!(
-                "lambda1 must be a finite number in [0, {MAX_LAMBDA1}], found {}",
-                self.lambda1
-            )));
+            return problem(
+                "lambda1",
+                format!(
+                    "expected a finite weight per degree in [0, {MAX_LAMBDA1}], found {}",
+                    self.lambda1
+                ),
+            );
         }
         if !(self.window_s.is_finite() && self.window_s > 0.0 && self.window_s <= MAX_SPAN_S) {
-            return Err(err(format!(
-                "window_s must be a positive number of seconds, at most {MAX_SPAN_S:e}, found {}",
-                self.window_s
-            )));
+            return problem(
+                "window_s",
+                format!(
+                    "expected a positive number of seconds, at most {MAX_SPAN_S:e}, found {}",
+                    self.window_s
+                ),
+            );
         }
         let least = self.window_s / MAX_OVERLAP;
         if !(self.hop_s.is_finite() && self.hop_s >= least && self.hop_s <= self.window_s) {
-            return Err(err(format!(
-                "hop_s must be between window_s / {MAX_OVERLAP} ({least}) and window_s ({}), found {}",
-                self.window_s, self.hop_s
-            )));
+            return problem(
+                "hop_s",
+                format!(
+                    "expected a number of seconds between window_s / {MAX_OVERLAP} ({least}) and window_s ({}), found {}",
+                    self.window_s, self.hop_s
+                ),
+            );
         }
-        Ok(())
+        None
+    }
+
+    /// [`Settings::problem`] as an error about `origin` as a whole.
+    pub fn validate(&self, origin: &str) -> Result<(), LimitsError> {
+        match self.problem() {
+            None => Ok(()),
+            Some(p) => Err(p.at(origin, 0, 0)),
+        }
     }
 }
 
@@ -475,22 +518,39 @@ impl LimitTable {
 
     /// Checks that every joint of `model` has all three axes.
     pub fn check_covers(&self, model: &Model, origin: &str) -> Result<(), LimitsError> {
+        self.check_covers_in(model, origin, None)
+    }
+
+    /// [`LimitTable::check_covers`], locating a missing row in `text`, the
+    /// CSV the table was parsed from: at the axis column of the joint's (or
+    /// its kind's) first row when it has some rows, else at the header's
+    /// `joint` column. Without the text the table as a whole is meant.
+    pub fn check_covers_in(
+        &self,
+        model: &Model,
+        origin: &str,
+        text: Option<&str>,
+    ) -> Result<(), LimitsError> {
         for j in &model.joints {
             for axis in 0..3 {
-                if self.row(&j.name, &j.kind, axis).is_none() {
-                    return Err(LimitsError {
-                        file: origin.into(),
-                        line: 0,
-                        column: 0,
-                        message: format!(
-                            "no row for joint '{}' (kind '{}') axis {} of model '{}'",
-                            j.name,
-                            j.kind,
-                            axis_name(axis),
-                            model.name
-                        ),
-                    });
+                if self.row(&j.name, &j.kind, axis).is_some() {
+                    continue;
                 }
+                let (line, column) = text.map_or((0, 0), |t| joint_rows_at(t, &j.name, &j.kind));
+                return Err(LimitsError {
+                    file: origin.into(),
+                    line,
+                    column,
+                    message: format!(
+                        "no row for joint '{}' (kind '{}') axis {} of model '{}': expected a row `{},{},...`",
+                        j.name,
+                        j.kind,
+                        axis_name(axis),
+                        model.name,
+                        j.kind,
+                        axis_name(axis),
+                    ),
+                });
             }
         }
         Ok(())
@@ -661,6 +721,32 @@ fn parse_row(
 }
 
 /// 1-based line of the TOML key `key` in `text` (1 when it is not found).
+/// Where the rows of a joint (by name, else by kind) start in a limit table's
+/// CSV text: line and axis column of the first, or the header's line and
+/// `joint` column when there are none.
+fn joint_rows_at(text: &str, joint: &str, kind: &str) -> (u64, usize) {
+    let header = text
+        .lines()
+        .position(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .map_or(1, |i| i as u64 + 1);
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .from_reader(text.as_bytes());
+    let mut by_kind = None;
+    for rec in rdr.records().map_while(Result::ok) {
+        let line = rec.position().map_or(header, |p| p.line());
+        match rec.get(0) {
+            Some(n) if n == joint => return (line, 2),
+            Some(n) if n == kind && by_kind.is_none() => by_kind = Some(line),
+            _ => {}
+        }
+    }
+    by_kind.map_or((header, 1), |line| (line, 2))
+}
+
 fn key_line(text: &str, key: &str) -> u64 {
     text.lines()
         .position(|l| {

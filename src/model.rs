@@ -358,51 +358,70 @@ impl Joint {
         self.dof.contains(&axis)
     }
 
-    fn validate(&self) -> Result<(), String> {
+    /// Checks the joint's own values; the error names the key at fault.
+    fn validate(&self) -> Result<(), (&'static str, String)> {
         let name = &self.name;
         for (k, a) in self.angle_axes.iter().enumerate() {
             if self.angle_axes[..k].iter().any(|b| b.axis == a.axis) {
-                return Err(format!(
-                    "joint '{name}': angle_axes names the segment axis '{}' twice (expected each of x, y, z once, e.g. [\"-z\", \"-y\", \"-x\"])",
-                    a.axis.name()
+                return Err((
+                    "angle_axes",
+                    format!(
+                        "joint '{name}': angle_axes names the segment axis '{}' twice (expected each of x, y, z once, e.g. [\"-z\", \"-y\", \"-x\"])",
+                        a.axis.name()
+                    ),
                 ));
             }
         }
         for (k, a) in self.dof.iter().enumerate() {
             if self.dof[..k].contains(a) {
-                return Err(format!(
-                    "joint '{name}': axis '{}' is listed twice in `dof`",
-                    a.name()
+                return Err((
+                    "dof",
+                    format!(
+                        "joint '{name}': axis '{}' is listed twice in `dof`",
+                        a.name()
+                    ),
                 ));
             }
         }
         for axis in Axis::ALL {
             let pose = self.default_pose_deg[axis.index()];
             if !(pose.is_finite() && (-180.0..=180.0).contains(&pose)) {
-                return Err(format!(
-                    "joint '{name}': default_pose_deg.{} = {pose} is not within -180..180",
-                    axis.name()
+                return Err((
+                    "default_pose_deg",
+                    format!(
+                        "joint '{name}': default_pose_deg.{} = {pose} is not within -180..180",
+                        axis.name()
+                    ),
                 ));
             }
             let Some([lo, hi]) = self.hard_limits_deg.get(axis) else {
                 continue;
             };
             if !self.moves(axis) {
-                return Err(format!(
-                    "joint '{name}': hard_limits_deg.{0} limits an axis that is not in `dof`",
-                    axis.name()
+                return Err((
+                    "hard_limits_deg",
+                    format!(
+                        "joint '{name}': hard_limits_deg.{0} limits an axis that is not in `dof`",
+                        axis.name()
+                    ),
                 ));
             }
             if !(lo.is_finite() && hi.is_finite() && -180.0 <= lo && lo < hi && hi <= 180.0) {
-                return Err(format!(
-                    "joint '{name}': hard_limits_deg.{} = [{lo}, {hi}]: expected lower < upper within -180..180",
-                    axis.name()
+                return Err((
+                    "hard_limits_deg",
+                    format!(
+                        "joint '{name}': hard_limits_deg.{} = [{lo}, {hi}]: expected lower < upper within -180..180",
+                        axis.name()
+                    ),
                 ));
             }
             if !(lo..=hi).contains(&pose) {
-                return Err(format!(
-                    "joint '{name}': default_pose_deg.{} = {pose} is outside its hard limits [{lo}, {hi}]",
-                    axis.name()
+                return Err((
+                    "default_pose_deg",
+                    format!(
+                        "joint '{name}': default_pose_deg.{} = {pose} is outside its hard limits [{lo}, {hi}]",
+                        axis.name()
+                    ),
                 ));
             }
         }
@@ -492,6 +511,15 @@ impl std::str::FromStr for ReferenceTarget {
 /// or an unknown built-in name (the file is then the name itself).
 pub type ModelError = crate::located::LocatedError;
 
+/// What is wrong with a model, and where: the path of the key at fault from
+/// the model's top (`["joint", "2", "proximal"]`: the third joint's
+/// `proximal`), for locating it in the file the model came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelProblem {
+    pub path: Vec<String>,
+    pub message: String,
+}
+
 impl Model {
     /// A built-in model by name (see [`BUILTIN_MODELS`]).
     pub fn builtin(name: &str) -> Result<Model, ModelError> {
@@ -537,9 +565,10 @@ impl Model {
     /// Parses and validates a model from TOML text; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Model, ModelError> {
         let model: Model = toml::from_str(text).map_err(|e| ModelError::toml(origin, text, &e))?;
-        model.validate().map_err(|message| {
-            let line = crate::input::line_naming(text, &message).unwrap_or(0);
-            ModelError::at(origin, line, usize::from(line > 0), message)
+        model.validate().map_err(|p| {
+            let keys: Vec<&str> = p.path.iter().map(String::as_str).collect();
+            let (line, column) = crate::input::locate::toml_key(text, &keys).unwrap_or((0, 0));
+            ModelError::at(origin, line, column, p.message)
         })?;
         Ok(model)
     }
@@ -548,74 +577,109 @@ impl Model {
     /// [`Model::from_toml`] checks one that did; `origin` names it in errors.
     pub fn check(&self, origin: &str) -> Result<(), ModelError> {
         self.validate()
-            .map_err(|message| ModelError::file(origin, message))
+            .map_err(|p| ModelError::file(origin, p.message))
     }
 
-    fn validate(&self) -> Result<(), String> {
+    /// The first thing wrong with the model, if any, with the key it is
+    /// about: what [`Model::from_toml`] and [`Model::check`] refuse.
+    pub fn problem(&self) -> Option<ModelProblem> {
+        self.validate().err()
+    }
+
+    fn validate(&self) -> Result<(), ModelProblem> {
+        let err = |path: &[&str], message: String| ModelProblem {
+            path: path.iter().map(|s| s.to_string()).collect(),
+            message,
+        };
         let imus: HashSet<&str> = self.imus.iter().map(String::as_str).collect();
-        if imus.len() != self.imus.len() {
-            return Err("an IMU is listed twice in `imus`".into());
+        if let Some(k) = (1..self.imus.len()).find(|&k| self.imus[..k].contains(&self.imus[k])) {
+            return Err(err(
+                &["imus", &k.to_string()],
+                format!("IMU '{}' is listed twice in `imus`", self.imus[k]),
+            ));
         }
         if !imus.contains(self.base.as_str()) {
-            return Err(format!("base IMU '{}' is not in `imus`", self.base));
+            return Err(err(
+                &["base"],
+                format!("base IMU '{}' is not in `imus`", self.base),
+            ));
         }
         let mut corrected: HashSet<&str> = HashSet::from([self.base.as_str()]);
         let mut names = HashSet::new();
-        for j in &self.joints {
+        for (i, j) in self.joints.iter().enumerate() {
+            let at = |key: &str, message: String| err(&["joint", &i.to_string(), key], message);
             if !names.insert(j.name.as_str()) {
-                return Err(format!("joint '{}' is listed twice", j.name));
+                return Err(at("name", format!("joint '{}' is listed twice", j.name)));
             }
-            for imu in [&j.proximal, &j.distal] {
+            for (key, imu) in [("proximal", &j.proximal), ("distal", &j.distal)] {
                 if !imus.contains(imu.as_str()) {
-                    return Err(format!("joint '{}': IMU '{imu}' is not in `imus`", j.name));
+                    return Err(at(
+                        key,
+                        format!("joint '{}': IMU '{imu}' is not in `imus`", j.name),
+                    ));
                 }
             }
             if !corrected.contains(j.proximal.as_str()) {
-                return Err(format!(
+                return Err(at("proximal", format!(
                     "joint '{}': proximal IMU '{}' must be the base or the distal IMU of an earlier joint (correction order)",
                     j.name, j.proximal
-                ));
+                )));
             }
             if !corrected.insert(j.distal.as_str()) {
-                return Err(format!(
-                    "joint '{}': IMU '{}' is already corrected by another joint or is the base",
-                    j.name, j.distal
+                return Err(at(
+                    "distal",
+                    format!(
+                        "joint '{}': IMU '{}' is already corrected by another joint or is the base",
+                        j.name, j.distal
+                    ),
                 ));
             }
         }
-        for j in &self.joints {
-            j.validate()?;
+        for (i, j) in self.joints.iter().enumerate() {
+            j.validate()
+                .map_err(|(key, message)| err(&["joint", &i.to_string(), key], message))?;
         }
         if self.pose.forward.axis == Axis::Z {
-            return Err(format!(
+            return Err(err(&["pose", "forward"], format!(
                 "pose.forward = {}: the model's forward axis must be horizontal (x or y; +z is vertical)",
                 self.pose.forward
-            ));
+            )));
         }
         for (imu, w) in &self.imu_weight {
             if !imus.contains(imu.as_str()) {
-                return Err(format!("imu_weight: IMU '{imu}' is not in `imus`"));
+                return Err(err(
+                    &["imu_weight", imu],
+                    format!("imu_weight: IMU '{imu}' is not in `imus`"),
+                ));
             }
             if !(w.is_finite() && *w > 0.0) {
-                return Err(format!(
-                    "imu_weight.{imu} = {w}: expected a positive number"
+                return Err(err(
+                    &["imu_weight", imu],
+                    format!("imu_weight.{imu} = {w}: expected a positive number"),
                 ));
             }
         }
         for (coordinate, target) in &self.reference_coordinates {
+            let at = &["reference_coordinates", coordinate.as_str()];
             let t: ReferenceTarget = target
                 .parse()
-                .map_err(|e| format!("reference_coordinates.{coordinate}: {e}"))?;
+                .map_err(|e| err(at, format!("reference_coordinates.{coordinate}: {e}")))?;
             if self.joint(&t.joint).is_none() {
-                return Err(format!(
-                    "reference_coordinates.{coordinate}: joint '{}' is not in the model",
-                    t.joint
+                return Err(err(
+                    at,
+                    format!(
+                        "reference_coordinates.{coordinate}: joint '{}' is not in the model",
+                        t.joint
+                    ),
                 ));
             }
         }
         for (alias, canon) in &self.aliases {
             if !imus.contains(canon.as_str()) {
-                return Err(format!("alias '{alias}' points to unknown IMU '{canon}'"));
+                return Err(err(
+                    &["aliases", alias],
+                    format!("alias '{alias}' points to unknown IMU '{canon}'"),
+                ));
             }
         }
         Ok(())

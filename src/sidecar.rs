@@ -146,14 +146,63 @@ impl Sidecar {
     }
 
     /// Checks what the sidecar would run with as if it came from files:
-    /// settings ([`Settings::validate`]), model ([`Model::check`]) and the
-    /// limit table (its hash, and rows for every joint kind of the model).
-    pub fn check(&self, origin: &str) -> anyhow::Result<()> {
-        self.settings.validate(&format!("{origin} (settings)"))?;
-        self.model.check(&format!("{origin} (model)"))?;
-        let table = self.table(origin)?;
-        table.check_covers(&self.model, &format!("{origin} (limits.csv)"))?;
+    /// settings ([`Settings::problem`]), model ([`Model::problem`]) and the
+    /// limit table (its rows, its hash, and rows for every joint kind of the
+    /// model). `text` is the sidecar's JSON as read from `origin`: errors
+    /// point at the key at fault there (`origin:line:column: settings.hop_s: ...`);
+    /// a problem inside the recorded table also names its line in `limits.csv`.
+    pub fn check(&self, origin: &str, text: &str) -> Result<(), crate::limits::LimitsError> {
+        let at = |path: &[&str], message: String| {
+            let (line, column) = crate::input::locate::json_key(text, path).unwrap_or((0, 0));
+            crate::limits::LimitsError {
+                file: origin.to_string(),
+                line,
+                column,
+                message,
+            }
+        };
+        if let Some(p) = self.settings.problem() {
+            return Err(at(
+                &["settings", p.key],
+                format!("settings.{}: {}", p.key, p.message),
+            ));
+        }
+        if let Some(p) = self.model.problem() {
+            let mut path = vec!["model"];
+            path.extend(p.path.iter().map(String::as_str));
+            return Err(at(&path, format!("model: {}", p.message)));
+        }
+        let in_table = |e: crate::limits::LimitsError| {
+            let place = match (e.line, e.column) {
+                (0, _) => String::new(),
+                (l, 0) => format!(" line {l}"),
+                (l, c) => format!(" line {l} column {c}"),
+            };
+            at(
+                &["limits", "csv"],
+                format!("limits.csv{place}: {}", e.message),
+            )
+        };
+        let table = LimitTable::parse(&self.limits.csv, "limits.csv").map_err(in_table)?;
+        if table.hash() != self.limits.sha256 {
+            return Err(at(
+                &["limits", "sha256"],
+                "limits.csv does not match limits.sha256 (the sidecar was edited?)".into(),
+            ));
+        }
+        table
+            .check_covers_in(&self.model, "limits.csv", Some(&self.limits.csv))
+            .map_err(in_table)?;
         Ok(())
+    }
+
+    /// Reads a sidecar file and [checks](Sidecar::check) it.
+    pub fn load_checked(path: &Path) -> anyhow::Result<Sidecar> {
+        let text = crate::input::read_text(path)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+        let sidecar = Sidecar::parse(&text, path)?;
+        sidecar.check(&path.display().to_string(), &text)?;
+        Ok(sidecar)
     }
 
     /// `None` when `input` hashes to the recorded input SHA-256, else the hash found.
@@ -173,7 +222,11 @@ impl Sidecar {
     pub fn load(path: &Path) -> anyhow::Result<Sidecar> {
         let text = crate::input::read_text(path)
             .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
-        serde_json::from_str(&text).map_err(|e| {
+        Sidecar::parse(&text, path)
+    }
+
+    fn parse(text: &str, path: &Path) -> anyhow::Result<Sidecar> {
+        serde_json::from_str(text).map_err(|e| {
             anyhow::anyhow!(
                 "{}:{}:{}: not a sidecar: {e}",
                 path.display(),

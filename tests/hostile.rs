@@ -31,12 +31,15 @@ const INPUT_CAP_MB: &str = "16";
 enum Expect {
     /// Exit 0 and an output that reads back.
     Ok,
-    /// Exit 3 and `file:line:column:` with a line >= 1 for the named file.
+    /// Exit 3 and `file:line:column:` (or `file:line:` for a whole line)
+    /// with a line and column >= 1 for the named file.
     Located(&'static str),
     /// Exit 1 or 3 and a message containing this text.
     Refused(&'static str),
     /// Either of `Ok` or a located error in the named file (random mutations).
     OkOrLocated(&'static str),
+    /// Exit 3 and exactly this line on stderr (the place and the words).
+    Exact(&'static str),
 }
 
 struct Case {
@@ -601,7 +604,11 @@ fn settings_cases() -> Vec<Case> {
             format!("{s}lambda_1 = 5\n"),
             Expect::Located("settings.toml"),
         ),
-        with("hop 0", set("hop_s", "0"), Expect::Located("settings.toml")),
+        with(
+            "hop 0",
+            set("hop_s", "0"),
+            Expect::Exact("acmw: joint_limits/settings.toml:7:1: hop_s: expected a number of seconds between window_s / 1000 (0.06) and window_s (60), found 0"),
+        ),
         with(
             "negative hop",
             set("hop_s", "-3"),
@@ -620,7 +627,7 @@ fn settings_cases() -> Vec<Case> {
         with(
             "lambda1 -5",
             set("lambda1", "-5"),
-            Expect::Located("settings.toml"),
+            Expect::Exact("acmw: joint_limits/settings.toml:4:1: lambda1: expected a finite weight per degree in [0, 1000000], found -5"),
         ),
         with(
             "lambda1 nan",
@@ -629,13 +636,13 @@ fn settings_cases() -> Vec<Case> {
         ),
         with(
             "glitch 500",
-            format!("{s}glitch_deg = 500\n").replace("glitch_deg = 30\n", ""),
-            Expect::OkOrLocated("settings.toml"),
+            format!("{s}  glitch_deg = 500\n").replace("glitch_deg = 30\n", ""),
+            Expect::Exact("acmw: joint_limits/settings.toml:11:3: glitch_deg: expected a number of degrees in (0, 180], found 500"),
         ),
         with(
             "table missing",
             set("table", "\"nope.csv\""),
-            Expect::Located("settings.toml"),
+            Expect::Exact("acmw: joint_limits/settings.toml:2:1: expected a limit table in joint_limits or a built-in one, found no 'nope.csv'"),
         ),
         with(
             "syntax error",
@@ -664,21 +671,35 @@ fn settings_cases() -> Vec<Case> {
         args.extend_from_slice(extra);
         case(name, vec![("t.csv", base.clone())], &args, expect)
     };
-    v.push(flags("--hop 0", &["--hop", "0"], Expect::Refused("hop_s")));
+    // A value from a flag is blamed on the flag, with what was expected.
+    v.push(flags(
+        "--hop 0",
+        &["--hop", "0"],
+        Expect::Exact("acmw: --hop: expected a number of seconds between window_s / 1000 (0.06) and window_s (60), found 0"),
+    ));
     v.push(flags(
         "--window -1",
         &["--window=-1"],
-        Expect::Refused("window_s"),
+        Expect::Exact(
+            "acmw: --window: expected a positive number of seconds, at most 1e7, found -1",
+        ),
     ));
     v.push(flags(
         "--lambda1 inf",
         &["--lambda1", "inf"],
-        Expect::Refused("lambda1"),
+        Expect::Exact(
+            "acmw: --lambda1: expected a finite weight per degree in [0, 1000000], found inf",
+        ),
     ));
     v.push(flags(
         "--window 0.5 --hop 1e-6",
         &["--window", "0.5", "--hop", "1e-6"],
-        Expect::Refused("hop_s"),
+        Expect::Exact("acmw: --hop: expected a number of seconds between window_s / 1000 (0.0005) and window_s (0.5), found 0.000001"),
+    ));
+    v.push(flags(
+        "--window 0.5 with the settings' hop",
+        &["--window", "0.5"],
+        Expect::Exact("acmw: --window: the settings' hop_s does not suit it: expected a number of seconds between window_s / 1000 (0.0005) and window_s (0.5), found 30; give --hop too"),
     ));
     v.push(flags(
         "--window 0.02 on 100 Hz",
@@ -770,19 +791,47 @@ fn table_model_calibration_cases() -> Vec<Case> {
         format!("{model}\n[[joint\n"),
         Expect::Located("m.toml"),
     ));
+    let cycle = model.replacen(
+        "proximal = \"base\"\ndistal = \"upper_back\"",
+        "proximal = \"upper_back\"\ndistal = \"base\"",
+        1,
+    );
+    let at = line_of(&cycle, "proximal = \"upper_back\"");
     v.push(m(
         "model cycle",
-        model.replacen(
-            "proximal = \"base\"\ndistal = \"upper_back\"",
-            "proximal = \"upper_back\"\ndistal = \"base\"",
-            1,
-        ),
-        Expect::Located("m.toml"),
+        cycle,
+        exact(format!("acmw: m.toml:{at}:1: joint 'back': proximal IMU 'upper_back' must be the base or the distal IMU of an earlier joint (correction order)")),
     ));
+    let nobody = model.replacen("base = \"base\"", "base = \"nobody\"", 1);
+    let at = line_of(&nobody, "base = \"nobody\"");
     v.push(m(
         "model base not an imu",
-        model.replacen("base = \"base\"", "base = \"nobody\"", 1),
-        Expect::Located("m.toml"),
+        nobody,
+        exact(format!(
+            "acmw: m.toml:{at}:1: base IMU 'nobody' is not in `imus`"
+        )),
+    ));
+    // `imus` lists base first: a second "base" in the list.
+    let twice = model.replacen("imus = [", "imus = [\"base\", ", 1);
+    let at = line_of(&twice, "imus = [");
+    v.push(m(
+        "model IMU listed twice",
+        twice,
+        exact(format!(
+            "acmw: m.toml:{at}:17: IMU 'base' is listed twice in `imus`"
+        )),
+    ));
+    // Coverage: a table without the knee's Y row points at the knee's rows.
+    let no_knee_y: String = table
+        .lines()
+        .filter(|l| !l.starts_with("knee,Y,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let at = line_of(&no_knee_y, "knee,");
+    v.push(lim(
+        "table without knee Y",
+        no_knee_y,
+        exact(format!("acmw: l.csv:{at}:2: no row for joint 'l_knee' (kind 'knee') axis Y of model 'infant13': expected a row `knee,Y,...`")),
     ));
     let cal = |name: &str, text: &str, expect| {
         let mut args = CORRECT.to_vec();
@@ -908,7 +957,7 @@ fn xsens_cases() -> Vec<Case> {
             c.clone(),
             c.clone(),
             "MT_01",
-            Expect::Located("MT_01_00B1.txt"),
+            Expect::Exact("acmw: ./MT_01_00B1.txt:2:17: update rate 1e-300 Hz: expected a finite rate from one sample an hour to 100000 Hz (a sample interval between 0.00001 s and 3600 s)"),
         ),
         rec(
             "update rate inf Hz",
@@ -916,7 +965,7 @@ fn xsens_cases() -> Vec<Case> {
             c.clone(),
             c.clone(),
             "MT_01",
-            Expect::Located("MT_01_00B1.txt"),
+            Expect::Exact("acmw: ./MT_01_00B1.txt:2:17: update rate 'infHz' is invalid: expected a finite positive rate in Hz, found inf"),
         ),
         rec(
             "update rate 0 Hz",
@@ -924,7 +973,7 @@ fn xsens_cases() -> Vec<Case> {
             c.clone(),
             c.clone(),
             "MT_01",
-            Expect::Located("MT_01_00B1.txt"),
+            Expect::Exact("acmw: ./MT_01_00B1.txt:2:17: update rate '0Hz' is invalid: expected a finite positive rate in Hz, found 0"),
         ),
         rec(
             "update rate NaN",
@@ -932,7 +981,23 @@ fn xsens_cases() -> Vec<Case> {
             c.clone(),
             c.clone(),
             "MT_01",
-            Expect::Located("MT_01_00B1.txt"),
+            Expect::Exact("acmw: ./MT_01_00B1.txt:2:17: update rate 'NaNHz' is invalid: expected a finite positive rate in Hz, found NaN"),
+        ),
+        rec(
+            "update rate -100 Hz",
+            "-100 Hz",
+            c.clone(),
+            c.clone(),
+            "MT_01",
+            Expect::Exact("acmw: ./MT_01_00B1.txt:2:17: update rate '-100 Hz' is invalid: expected a finite positive rate in Hz, found -100"),
+        ),
+        rec(
+            "update rate not a number",
+            "fast",
+            c.clone(),
+            c.clone(),
+            "MT_01",
+            Expect::Exact("acmw: ./MT_01_00B1.txt:2:17: update rate 'fast' is invalid: expected a rate in Hz such as 100.0Hz"),
         ),
         rec(
             "no common packet",
@@ -967,6 +1032,19 @@ fn xsens_cases() -> Vec<Case> {
             Expect::Located("m.xml"),
         ),
     ]
+}
+
+/// 1-based line of the first line of `text` that starts with `start`.
+fn line_of(text: &str, start: &str) -> usize {
+    1 + text
+        .lines()
+        .position(|l| l.trim_start().starts_with(start))
+        .unwrap_or_else(|| panic!("no line starting {start:?}"))
+}
+
+/// [`Expect::Exact`] of a message built at run time.
+fn exact(line: String) -> Expect {
+    Expect::Exact(Box::leak(line.into_boxed_str()))
 }
 
 /// Runs one case in a fresh folder; `None` when it behaved, else what went wrong.
@@ -1020,6 +1098,7 @@ fn run(c: &Case) -> Option<String> {
     let Some(code) = status.code() else {
         return Some(format!("killed by a signal ({status:?}): {stderr}"));
     };
+    // `file:line:column: ...`, or `file:line: ...` when the whole line is meant.
     let located = |file: &str| -> bool {
         stderr.lines().any(|l| {
             let Some(i) = l.find(file) else { return false };
@@ -1029,7 +1108,9 @@ fn run(c: &Case) -> Option<String> {
                     .next()
                     .and_then(|n| n.parse::<u64>().ok())
                     .is_some_and(|n| n >= 1)
-                && parts.next().and_then(|n| n.parse::<u64>().ok()).is_some()
+                && parts
+                    .next()
+                    .is_some_and(|n| n.parse::<u64>().is_ok_and(|c| c >= 1) || n.starts_with(' '))
         })
     };
     let output_reads_back = || {
@@ -1046,6 +1127,7 @@ fn run(c: &Case) -> Option<String> {
         Expect::Located(f) => code == 3 && located(f),
         Expect::Refused(s) => (code == 1 || code == 3) && stderr.contains(s),
         Expect::OkOrLocated(f) => (code == 0 && output_reads_back()) || (code == 3 && located(f)),
+        Expect::Exact(line) => code == 3 && stderr.lines().any(|l| l == line),
     };
     (!ok).then(|| format!("exit {code}, expected {:?}: {stderr}", c.expect))
 }
@@ -1076,4 +1158,85 @@ fn hostile_corpus_ends_in_results_or_located_errors() {
         cases.len(),
         failures.join("\n")
     );
+}
+
+/// `--from-sidecar` with an edited sidecar: the error names the sidecar and
+/// the line and column of the key at fault in it (exit 3).
+#[test]
+fn sidecar_errors_point_at_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("t.csv"), quat_csv(&times(200))).unwrap();
+    let acmw = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_acmw"))
+            .current_dir(dir.path())
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let out = acmw(CORRECT);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.path().join("out.csv.acmw.json")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let hash = json["limits"]["sha256"].as_str().unwrap();
+    let hash_key = format!("\"sha256\": \"{hash}\"");
+    let edited_hash = format!("\"sha256\": \"0{}\"", &hash[1..]);
+    let cases = [
+        (
+            "\"hop_s\": 30.0",
+            "\"hop_s\": 0.0",
+            "settings.hop_s: expected a number of seconds between window_s / 1000 (0.06) and window_s (60), found 0",
+        ),
+        (
+            "\"lambda1\": 0.05",
+            "\"lambda1\": -5.0",
+            "settings.lambda1: expected a finite weight per degree in [0, 1000000], found -5",
+        ),
+        (
+            "\"base\": \"base\"",
+            "\"base\": \"nobody\"",
+            "model: base IMU 'nobody' is not in `imus`",
+        ),
+        (
+            "\"proximal\": \"base\"",
+            "\"proximal\": \"head\"",
+            "model: joint 'back': proximal IMU 'head' must be the base or the distal IMU of an earlier joint (correction order)",
+        ),
+        (
+            &hash_key,
+            &edited_hash,
+            "limits.csv does not match limits.sha256 (the sidecar was edited?)",
+        ),
+    ];
+    for (from, to, message) in cases {
+        let edited = text.replacen(from, to, 1);
+        assert_ne!(edited, text, "{from} not in the sidecar");
+        std::fs::write(dir.path().join("s.json"), &edited).unwrap();
+        let at = edited.find(to).unwrap();
+        let line = edited[..at].matches('\n').count() + 1;
+        let column = at - edited[..at].rfind('\n').map_or(0, |i| i + 1) + 1;
+        let out = acmw(&[
+            "correct",
+            "t.csv",
+            "--from-sidecar",
+            "s.json",
+            "-o",
+            "again.csv",
+            "--quiet",
+        ]);
+        assert_eq!(
+            (
+                out.status.code(),
+                String::from_utf8_lossy(&out.stderr).into_owned()
+            ),
+            (
+                Some(3),
+                format!("acmw: s.json:{line}:{column}: {message}\n")
+            ),
+            "{from} -> {to}"
+        );
+    }
 }

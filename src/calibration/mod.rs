@@ -306,12 +306,14 @@ impl Calibration {
     pub fn from_toml(text: &str, origin: &str) -> Result<Calibration, CalibrationError> {
         let c: Calibration =
             toml::from_str(text).map_err(|e| CalibrationError::toml(origin, text, &e))?;
-        for s in &c.segments {
+        for (i, s) in c.segments.iter().enumerate() {
             let n = s.q.iter().map(|v| v * v).sum::<f64>().sqrt();
             if !(n.is_finite() && (n - 1.0).abs() < 1e-3) {
                 let message = format!("IMU '{}': q is not a unit quaternion (norm {n})", s.imu);
-                let line = crate::input::line_naming(text, &message).unwrap_or(0);
-                return Err(CalibrationError::at(origin, line, 1, message));
+                let (line, column) =
+                    crate::input::locate::toml_key(text, &["segment", &i.to_string(), "q"])
+                        .unwrap_or((0, 0));
+                return Err(CalibrationError::at(origin, line, column, message));
             }
         }
         Ok(c)

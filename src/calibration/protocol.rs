@@ -239,21 +239,24 @@ impl Protocol {
             movements,
             text: text.to_string(),
         };
-        p.check_axes(origin)?;
+        if let Some((k, message)) = p.axes_problem() {
+            return Err(at(raw.segments[k].span(), message));
+        }
         Ok(p)
     }
 
-    /// Every IMU needs two non-parallel axes to fix a rotation.
-    fn check_axes(&self, origin: &str) -> Result<(), CalibrationError> {
-        for seg in &self.segments {
+    /// Every IMU needs two non-parallel axes to fix a rotation: the index in
+    /// `segments` of the first IMU that has not, and why.
+    fn axes_problem(&self) -> Option<(usize, String)> {
+        for (k, seg) in self.segments.iter().enumerate() {
             let axes: Vec<usize> = self
                 .movements
                 .iter()
                 .filter_map(|m| m.axes.get(seg).map(|a| a.index))
                 .collect();
             if !axes.iter().any(|&a| a != axes[0]) {
-                return Err(CalibrationError::file(
-                    origin,
+                return Some((
+                    k,
                     format!(
                         "IMU '{seg}': its movements give {} distinct functional axis; at least two non-parallel axes are needed to fix a rotation",
                         if axes.is_empty() { 0 } else { 1 }
@@ -261,7 +264,7 @@ impl Protocol {
                 ));
             }
         }
-        Ok(())
+        None
     }
 
     /// The movement with this label.
@@ -342,6 +345,8 @@ mod tests {
             "{HEAD}[[movement]]\nlabel = \"m\"\nkind = \"static\"\naxes = {{ a = \"x\" }}\n[[movement]]\nlabel = \"n\"\nkind = \"functional\"\naxes = {{ a = \"-x\" }}\n"
         ));
         assert!(e.message.contains("two non-parallel"), "{e}");
+        // At the IMU's entry in `segments`.
+        assert_eq!((e.line, e.column), (2, 13), "{e}");
         let e = err("name = 1\n");
         assert_eq!(e.line, 1, "{e}");
     }

@@ -196,6 +196,27 @@ fn calibration_file_round_trips_and_errors_are_located() {
         + 1;
     assert_eq!((e.file.as_str(), e.line), ("c.toml", line), "{e}");
     assert!(e.column > 0);
+    // A q that is not a unit quaternion: at the second segment's `q` key.
+    let mut twice = cal.clone();
+    twice.segments[1].q = [2.0, 0.0, 0.0, 0.0];
+    let text2 = twice.to_toml();
+    let line = text2
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.starts_with("q = "))
+        .nth(1)
+        .unwrap()
+        .0
+        + 1;
+    assert_eq!(
+        Calibration::from_toml(&text2, "c.toml")
+            .unwrap_err()
+            .to_string(),
+        format!(
+            "c.toml:{line}:1: IMU '{}': q is not a unit quaternion (norm 2)",
+            twice.segments[1].imu
+        )
+    );
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.calibration.toml");
     cal.save(&path).unwrap();

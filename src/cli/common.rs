@@ -2,7 +2,7 @@
 
 use acm_workbench::calibration::AppliedCalibration;
 use acm_workbench::correct::pipeline::{self, Preparation, Prepared, Setup, Source};
-use acm_workbench::limits::{LimitTable, LimitsDir, Settings};
+use acm_workbench::limits::{LimitTable, LimitsDir, LimitsError, Settings, SettingsProblem};
 use acm_workbench::model::{Model, SignedAxis};
 use acm_workbench::names::Named;
 use acm_workbench::pose::{PoseCalibration, PoseTime};
@@ -181,7 +181,11 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
         Some(p) => (LimitTable::load(p)?, p.display().to_string()),
         None => (dir.table, dir.table_source),
     };
-    limits.check_covers(&model, &limits_source)?;
+    limits.check_covers_in(
+        &model,
+        &limits_source,
+        table_text(&limits_source).as_deref(),
+    )?;
     let defaults = dir.settings.settings();
     let settings = Settings {
         lambda1: args.lambda1.unwrap_or(defaults.lambda1),
@@ -190,7 +194,9 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
         vertical: args.vertical.unwrap_or(defaults.vertical),
         solver: args.solver.unwrap_or(defaults.solver),
     };
-    settings.validate("command line")?;
+    if let Some(p) = settings.problem() {
+        return Err(flag_error(args, &p).into());
+    }
     Ok(Context {
         model,
         limits,
@@ -198,6 +204,49 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
         settings,
         glitch_deg: dir.settings.glitch_deg,
     })
+}
+
+/// The CSV text of a limit table by its source (a path, or `<built-in NAME>`),
+/// for locating a coverage error; `None` when it cannot be read again.
+fn table_text(source: &str) -> Option<String> {
+    let builtin = acm_workbench::limits::BUILTIN_TABLES
+        .iter()
+        .find(|(n, _)| source == format!("<built-in {n}>"));
+    match builtin {
+        Some((_, text)) => Some(text.to_string()),
+        None => acm_workbench::input::read_text(Path::new(source)).ok(),
+    }
+}
+
+/// A settings problem after the flags were applied, as an error about the
+/// flag that set the value (`--hop: expected ...`). A file's values were
+/// checked when it was read, so the value at fault was set by a flag, or
+/// the file's `hop_s` no longer suits the `--window` given.
+fn flag_error(args: &EngineArgs, p: &SettingsProblem) -> LimitsError {
+    let own = match p.key {
+        "lambda1" => args.lambda1.map(|_| "--lambda1"),
+        "window_s" => args.window.map(|_| "--window"),
+        "hop_s" => args.hop.map(|_| "--hop"),
+        _ => None,
+    };
+    match (own, args.window) {
+        (Some(flag), _) => LimitsError {
+            file: flag.into(),
+            line: 0,
+            column: 0,
+            message: p.message.clone(),
+        },
+        (None, Some(_)) if p.key == "hop_s" => LimitsError {
+            file: "--window".into(),
+            line: 0,
+            column: 0,
+            message: format!(
+                "the settings' hop_s does not suit it: {}; give --hop too",
+                p.message
+            ),
+        },
+        _ => p.at("command line", 0, 0),
+    }
 }
 
 /// Progress on stderr: a line updated in place on a terminal, silent otherwise

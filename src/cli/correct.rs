@@ -57,9 +57,8 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     let mut recorded_calibration = None;
     let (ctx, variant, pose) = match &args.from_sidecar {
         Some(p) => {
-            let s = Sidecar::load(p)?;
+            let s = Sidecar::load_checked(p)?;
             let origin = p.display().to_string();
-            s.check(&origin)?;
             let found = s.check_input(&args.input)?;
             if let Some(found) = found {
                 let what = format!(

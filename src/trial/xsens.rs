@@ -111,6 +111,9 @@ pub struct XsensExport {
     pub origin: String,
     /// The rate of `// Update Rate: <Hz>`, when the file has that comment.
     pub rate_hz: Option<f64>,
+    /// Line and column (1-based, characters) of that rate's value; 1 and 1
+    /// without one.
+    pub rate_at: (u64, usize),
     /// The rate implied by `SampleTimeFine` (median ticks per packet), when the
     /// file has that column filled in.
     pub sample_time_rate_hz: Option<f64>,
@@ -265,18 +268,26 @@ fn columns(header: &[&str], origin: &str, line: u64) -> Result<Columns, TrialErr
     ))
 }
 
-/// `100.0Hz` of a `// Update Rate: 100.0Hz` comment.
-fn rate_of_comment(comment: &str) -> Option<f64> {
+/// The value of a `// Update Rate: 100.0Hz` comment: `None` when the
+/// comment is another; else the rate in Hz, or why the value is not one
+/// (not a number, or not finite and positive). `value` is the text after the
+/// colon, trimmed (what messages show).
+fn rate_of_comment(comment: &str) -> Option<(&str, Result<f64, String>)> {
     let value = comment_value(comment, "update rate")?;
     let v = value
         .strip_suffix("Hz")
         .or_else(|| value.strip_suffix("hz"))
         .unwrap_or(value);
-    v.trim()
-        .replace(',', ".")
-        .parse::<f64>()
-        .ok()
-        .filter(|r| r.is_finite() && *r > 0.0)
+    let rate = match v.trim().replace(',', ".").parse::<f64>() {
+        Ok(r) if r.is_finite() && r > 0.0 => Ok(r),
+        Ok(r) => Err(format!(
+            "update rate '{value}' is invalid: expected a finite positive rate in Hz, found {r}"
+        )),
+        Err(_) => Err(format!(
+            "update rate '{value}' is invalid: expected a rate in Hz such as 100.0Hz"
+        )),
+    };
+    Some((value, rate))
 }
 
 /// The value of a `// Key: value` comment when its key is `key` (any case).
@@ -384,6 +395,7 @@ impl Cells<'_> {
 pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError> {
     let mut lines = LineIter::new(text);
     let mut rate_hz = None;
+    let mut rate_at = (1, 1);
     let mut coordinate_system = None;
     let (header_line, header_text) = loop {
         let Some((n, l)) = lines.next_nonblank() else {
@@ -396,7 +408,13 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
         };
         match l.trim_start().strip_prefix("//") {
             Some(c) => {
-                rate_hz = rate_hz.or_else(|| rate_of_comment(c));
+                if let (None, Some((value, rate))) = (rate_hz, rate_of_comment(c)) {
+                    // Column (characters) of the value in the line.
+                    let offset = value.as_ptr() as usize - l.as_ptr() as usize;
+                    let column = l[..offset].chars().count() + 1;
+                    rate_at = (n, column);
+                    rate_hz = Some(rate.map_err(|m| TrialError::at(origin, n, column, m))?);
+                }
                 coordinate_system = coordinate_system.or_else(|| {
                     comment_value(c, "coordinate system").map(|v| v.to_ascii_uppercase())
                 });
@@ -412,6 +430,7 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
     let mut out = XsensExport {
         origin: origin.to_string(),
         rate_hz,
+        rate_at,
         sample_time_rate_hz: None,
         coordinate_system,
         delimiter,
@@ -550,9 +569,18 @@ mod tests {
 
     #[test]
     fn update_rate_comment() {
-        assert_eq!(rate_of_comment(" Update Rate: 100.0Hz"), Some(100.0));
-        assert_eq!(rate_of_comment(" Update Rate: 60 Hz"), Some(60.0));
-        assert_eq!(rate_of_comment(" Filter Profile: human (46.1)"), None);
+        let rate = |c: &str| rate_of_comment(c).map(|(_, r)| r);
+        assert_eq!(rate(" Update Rate: 100.0Hz"), Some(Ok(100.0)));
+        assert_eq!(rate(" Update Rate: 60 Hz"), Some(Ok(60.0)));
+        assert_eq!(rate(" Filter Profile: human (46.1)"), None);
+        for bad in ["0Hz", "-100Hz", "nanHz", "infHz", "fastHz"] {
+            let comment = format!(" Update Rate: {bad}");
+            let r = rate(&comment);
+            assert!(
+                matches!(&r, Some(Err(m)) if m.contains(&format!("'{bad}' is invalid"))),
+                "{bad}: {r:?}"
+            );
+        }
     }
 
     #[test]

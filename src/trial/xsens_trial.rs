@@ -453,14 +453,14 @@ fn common_rate(exports: &[(String, XsensExport)]) -> Result<f64, TrialError> {
     let mut rate: Option<(f64, &str)> = None;
     for (_, e) in exports {
         if let Some(r) = e.rate_hz {
-            check_rate(r, &e.origin)?;
+            check_rate(r, &e.origin, e.rate_at)?;
             match rate {
                 None => rate = Some((r, &e.origin)),
                 Some((r0, o0)) if (r - r0).abs() > 1e-9 * r0 => {
                     return Err(TrialError::at(
                         &e.origin,
-                        1,
-                        1,
+                        e.rate_at.0,
+                        e.rate_at.1,
                         format!("update rate {r} Hz differs from {r0} Hz of {o0}; expected one rate for all sensors"),
                     ))
                 }
@@ -476,7 +476,11 @@ fn common_rate(exports: &[(String, XsensExport)]) -> Result<f64, TrialError> {
         .iter()
         .find_map(|(_, e)| Some((e.sample_time_rate_hz?, &e.origin)));
     if let Some((r, origin)) = found {
-        check_rate(r, origin)?;
+        // Derived from the SampleTimeFine column, not from one place.
+        check_rate(r, origin, (0, 0)).map_err(|mut e| {
+            e.message = format!("SampleTimeFine steps give an {}", e.message);
+            e
+        })?;
     }
     found
         .map(|(r, _)| r)
@@ -505,17 +509,25 @@ fn frame_warning(exports: &[(String, XsensExport)]) -> Option<String> {
 
 /// The update rate of an export is a rate a trial can have: finite, with a
 /// sample interval within the bounds every reader keeps to.
-fn check_rate(rate_hz: f64, origin: &str) -> Result<(), TrialError> {
+/// `at`: line and column of the value the rate came from.
+fn check_rate(rate_hz: f64, origin: &str, at: (u64, usize)) -> Result<(), TrialError> {
     use crate::trial::timing::{MAX_MEDIAN_DT_S, MIN_MEDIAN_DT_S};
-    let (lo, hi) = (1.0 / MAX_MEDIAN_DT_S, 1.0 / MIN_MEDIAN_DT_S);
+    let (lo, hi) = (1.0 / MAX_MEDIAN_DT_S, (1.0 / MIN_MEDIAN_DT_S).round());
     if rate_hz.is_finite() && (lo..=hi).contains(&rate_hz) {
         return Ok(());
     }
     Err(TrialError::at(
         origin,
-        1,
-        1,
-        format!("update rate {rate_hz} Hz: expected a finite rate between {lo:e} Hz and {hi:e} Hz"),
+        at.0,
+        at.1,
+        format!(
+            "update rate {} Hz: expected a finite rate from one sample an hour to {hi} Hz (a sample interval between {MIN_MEDIAN_DT_S} s and {MAX_MEDIAN_DT_S} s)",
+            if (1e-3..1e7).contains(&rate_hz.abs()) {
+                rate_hz.to_string()
+            } else {
+                format!("{rate_hz:e}")
+            }
+        ),
     ))
 }
 
