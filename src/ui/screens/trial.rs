@@ -3,6 +3,7 @@
 use crate::limits::axis_name;
 use crate::metrics::JointFigures;
 use crate::ui::cells::{fit, num, sel};
+use crate::ui::glyphs::{sample, Glyphs};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Nav, Reply, Screen, ViewKind};
 use crate::ui::theme::Theme;
@@ -114,18 +115,58 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let (s0, s1) = app.view.span(d);
     let ci = index_at(t, app.view.cursor_s + origin);
     let glitches = crate::ui::glitches::of_joint(l, &joint.name);
-    let [charts, foot] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
+    let glyphs = theme.glyphs(app.view.braille);
+    let [charts, legend_row, foot] = Layout::vertical([
+        Constraint::Min(1),
+        Constraint::Length(1),
+        Constraint::Length(1),
+    ])
+    .areas(right);
     let parts = Layout::vertical([Constraint::Ratio(1, 3); 3]).split(charts);
-    for axis in 0..3 {
-        let range = lim.map(|l| l.range_deg[axis]);
-        let centroid = lim.and_then(|l| l.centroid_deg).map(|c| c[axis]);
-        let mut title = vec![Span::styled(format!(" {} ", axis_name(axis)), theme.header)];
-        if let Some([lo, hi]) = range {
+    let data: Vec<ChartData> = (0..3)
+        .map(|axis| ChartData {
+            t,
+            origin,
+            axis,
+            raw: &raw,
+            cor: cor.as_deref().map(Vec::as_slice),
+            range: lim.map(|l| l.range_deg[axis]),
+            centroid: lim.and_then(|l| l.centroid_deg).map(|c| c[axis]),
+            span: (s0, s1),
+            cursor: app.view.cursor_s,
+            glyphs,
+            glitches: crate::ui::glitches::markers(&glitches, &raw, axis, (s0, s1)),
+        })
+        .collect();
+    // One label width for the three charts: their time axes line up.
+    let frames: Vec<Option<Frame_>> = data
+        .iter()
+        .zip(parts.iter())
+        .map(|(d, a)| frame_of(d, *a, theme.ascii))
+        .collect();
+    let label_w = frames
+        .iter()
+        .flatten()
+        .flat_map(|fr| fr.labels.iter().map(|(_, s)| s.chars().count()))
+        .max()
+        .unwrap_or(1) as u16;
+    for (axis, (d, fr)) in data.iter().zip(frames).enumerate() {
+        let Some(fr) = fr else { continue };
+        let mut title = vec![Span::styled(
+            format!(
+                " {}{} ",
+                axis_name(axis),
+                if theme.ascii { " deg" } else { "" }
+            ),
+            theme.header,
+        )];
+        if let Some([lo, hi]) = d.range {
             title.push(Span::styled(format!("[{lo}, {hi}] "), theme.limit));
         }
-        if let Some(c) = centroid {
+        if let Some(c) = d.centroid {
             title.push(Span::styled(format!("c {c} "), theme.centroid));
         }
+        title.push(Span::styled("at cursor ", theme.dim));
         title.push(Span::styled(
             format!("raw {} ", num(raw.get(ci).map(|a| a[axis]), 0)),
             theme.raw,
@@ -136,26 +177,34 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
                 theme.corrected,
             ));
         }
-        chart(
-            f,
-            parts[axis],
-            theme,
-            Line::from(title),
-            ChartData {
-                t,
-                origin,
-                axis,
-                raw: &raw,
-                cor: cor.as_deref().map(Vec::as_slice),
-                range,
-                centroid,
-                span: (s0, s1),
-                cursor: app.view.cursor_s,
-                braille: app.view.braille,
-                glitches: crate::ui::glitches::markers(&glitches, &raw, axis, (s0, s1)),
-            },
-        );
+        chart(f, parts[axis], theme, Line::from(title), d, fr, label_w);
     }
+    let mut legend = vec![(sample(glyphs.raw), "raw".to_string(), theme.raw)];
+    if cor.is_some() {
+        legend.push((
+            sample(glyphs.corrected),
+            app.variant.to_string(),
+            theme.corrected,
+        ));
+    }
+    if lim.is_some() {
+        legend.push((sample(glyphs.limit), "limits".into(), theme.limit));
+    }
+    if lim.is_some_and(|l| l.centroid_deg.is_some()) {
+        legend.push((sample(glyphs.centroid), "centroid".into(), theme.centroid));
+    }
+    // A vertical line: one of its glyph.
+    let cursor: String = sample(glyphs.cursor).chars().take(1).collect();
+    legend.push((cursor, "cursor".into(), theme.cursor));
+    if !glitches.is_empty() {
+        legend.push((sample(glyphs.glitch), "glitch".into(), theme.warn));
+    }
+    let mut spans = vec![Span::raw(" ")];
+    for (glyph, name, style) in legend {
+        spans.push(Span::styled(glyph, style));
+        spans.push(Span::raw(format!(" {name}  ")));
+    }
+    f.render_widget(Paragraph::new(Line::from(spans)), legend_row);
     let note = e
         .variant_note_short(app.variant)
         .filter(|_| e.running.is_none());
@@ -212,23 +261,82 @@ struct ChartData<'a> {
     centroid: Option<f64>,
     span: (f64, f64),
     cursor: f64,
-    braille: bool,
+    glyphs: Glyphs,
     /// Glitch markers `(time, angle)` of the joint's IMUs in view.
     glitches: Vec<(f64, f64)>,
 }
 
-fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
+/// What a chart shows before it is drawn: the traces reduced to the columns
+/// of its plot, the angle bounds and the y-axis tick labels.
+struct Frame_ {
+    raw: Vec<(f64, f64)>,
+    cor: Vec<(f64, f64)>,
+    /// Angle bounds of the plot, degrees.
+    lo: f64,
+    hi: f64,
+    /// (value, label) of the round ticks inside the bounds.
+    labels: Vec<(f64, String)>,
+}
+
+/// Round tick values inside `[lo, hi]`: multiples of a step of 1, 2 or 5
+/// times a power of ten, at most `max` of them (at least one step is tried
+/// until few enough fit; none when the bounds are not finite).
+pub fn ticks(lo: f64, hi: f64, max: usize) -> (f64, Vec<f64>) {
+    let max = max.max(1);
+    if !(lo.is_finite() && hi.is_finite()) || hi <= lo {
+        return (1.0, vec![]);
+    }
+    let mut decade = 10f64.powf(((hi - lo) / max as f64).log10().floor());
+    loop {
+        for m in [1.0, 2.0, 5.0] {
+            let step = decade * m;
+            let (first, last) = ((lo / step).ceil() as i64, (hi / step).floor() as i64);
+            if last < first || ((last - first + 1) as usize) <= max {
+                // `+ 0.0` turns -0 into 0.
+                let vals = (first..=last).map(|k| k as f64 * step + 0.0).collect();
+                return (step, vals);
+            }
+        }
+        decade *= 10.0;
+    }
+}
+
+/// A tick label: the value with as many decimals as the step needs, and the
+/// unit (degrees; ASCII charts name it in the title instead).
+fn tick_label(v: f64, step: f64, ascii: bool) -> String {
+    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    let unit = if ascii { "" } else { "°" };
+    format!("{v:.decimals$}{unit}")
+}
+
+/// The row of `v` in a plot `height` rows tall over `[lo, hi]`, from the top
+/// (as the chart's one-per-cell markers place it).
+fn row_of(v: f64, lo: f64, hi: f64, height: u16) -> u16 {
+    let h = f64::from(height.saturating_sub(1));
+    ((hi - v) * h / (hi - lo)).round().clamp(0.0, h) as u16
+}
+
+/// The plot's content and axis for a chart in `area` (None when too small).
+fn frame_of(d: &ChartData, area: Rect, ascii: bool) -> Option<Frame_> {
     if area.height < 2 || area.width < 10 {
-        return;
+        return None;
     }
     let (s0, s1) = d.span;
-    let label_w = 5u16;
-    let cols = area.width.saturating_sub(label_w + 1).max(1) as usize;
-    let per_col = if d.braille { 2 } else { 1 };
-    let raw = envelope(d.t, d.origin, |i| d.raw[i][d.axis], s0, s1, cols * per_col);
+    // The plot is narrower by the labels and the axis: a few columns of
+    // envelope more than needed cost nothing visible.
+    let cols = area.width.saturating_sub(6).max(1) as usize;
+    let raw_per_col = crate::ui::glyphs::dots_per_cell(d.glyphs.raw).0;
+    let raw = envelope(
+        d.t,
+        d.origin,
+        |i| d.raw[i][d.axis],
+        s0,
+        s1,
+        cols * raw_per_col,
+    );
     let cor = d
         .cor
-        .map(|c| envelope(d.t, d.origin, |i| c[i][d.axis], s0, s1, cols * per_col))
+        .map(|c| envelope(d.t, d.origin, |i| c[i][d.axis], s0, s1, cols))
         .unwrap_or_default();
     // Bounds: the data in view and the limits.
     let mut lo = f64::INFINITY;
@@ -247,64 +355,96 @@ fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
     }
     let pad = ((hi - lo) * 0.05).max(0.5);
     let (lo, hi) = (lo - pad, hi + pad);
+    // A tick at most every other row.
+    let plot_h = area.height.saturating_sub(1) as usize;
+    let (step, vals) = ticks(lo, hi, plot_h.div_ceil(2).clamp(1, 5));
+    let labels = vals
+        .into_iter()
+        .map(|v| (v, tick_label(v, step, ascii)))
+        .collect();
+    Some(Frame_ {
+        raw,
+        cor,
+        lo,
+        hi,
+        labels,
+    })
+}
+
+fn chart(
+    f: &mut Frame,
+    area: Rect,
+    theme: &Theme,
+    title: Line,
+    d: &ChartData,
+    fr: Frame_,
+    label_w: u16,
+) {
+    let (s0, s1) = d.span;
+    let (lo, hi) = (fr.lo, fr.hi);
+    let g = d.glyphs;
     let lower: Vec<(f64, f64)>;
     let upper: Vec<(f64, f64)>;
     let centre: Vec<(f64, f64)>;
     let cursor = vec![(d.cursor, lo), (d.cursor, hi)];
-    let marker = if d.braille {
-        Marker::Braille
-    } else {
-        Marker::Dot
-    };
     // Limit lines first: a later dataset overwrites whole cells.
     let mut sets = vec![];
     if let Some([a, b]) = d.range {
         lower = vec![(s0, a), (s1, a)];
         upper = vec![(s0, b), (s1, b)];
-        sets.push(line(&lower, theme.limit, marker));
-        sets.push(line(&upper, theme.limit, marker));
+        sets.push(line(&lower, theme.limit, g.limit));
+        sets.push(line(&upper, theme.limit, g.limit));
     }
     if let Some(c) = d.centroid {
         centre = vec![(s0, c), (s1, c)];
-        sets.push(line(&centre, theme.centroid, marker));
+        sets.push(line(&centre, theme.centroid, g.centroid));
     }
     if d.cursor >= s0 && d.cursor <= s1 {
-        sets.push(line(&cursor, theme.cursor, marker));
+        sets.push(line(&cursor, theme.cursor, g.cursor));
     }
-    sets.push(line(&raw, theme.raw, marker));
-    if !cor.is_empty() {
-        sets.push(line(&cor, theme.corrected, marker));
+    sets.push(line(&fr.raw, theme.raw, g.raw));
+    if !fr.cor.is_empty() {
+        sets.push(line(&fr.cor, theme.corrected, g.corrected));
     }
-    // Glitches last, as full blocks: a glyph of their own, not colour alone.
+    // Glitches last: a glyph of their own, not colour alone.
     if !d.glitches.is_empty() {
         sets.push(
             Dataset::default()
                 .data(&d.glitches)
                 .graph_type(GraphType::Scatter)
-                .marker(Marker::Block)
+                .marker(g.glitch)
                 .style(theme.warn),
         );
     }
-    let y_labels = if area.height >= 7 {
-        vec![
-            format!("{lo:.0}"),
-            format!("{:.0}", (lo + hi) / 2.0),
-            format!("{hi:.0}"),
-        ]
-    } else {
-        vec![format!("{lo:.0}"), format!("{hi:.0}")]
-    };
+    // Blank labels of the common width keep the plot where the other charts
+    // have theirs; the round ticks are written at their own rows below.
+    let label_w = label_w.min(area.width / 3);
+    let blank = " ".repeat(label_w as usize);
     let chart = Chart::new(sets)
         .block(Block::new().borders(Borders::TOP).title(title))
         .x_axis(Axis::default().bounds([s0, s1]))
         .y_axis(
             Axis::default()
                 .bounds([lo, hi])
-                .labels(y_labels)
+                .labels(vec![blank.clone(), blank])
                 .style(theme.dim),
         )
         .legend_position(None);
     f.render_widget(chart, area);
+    let plot_h = area.height.saturating_sub(1);
+    let buf = f.buffer_mut();
+    for (v, label) in &fr.labels {
+        let y = area.y + 1 + row_of(*v, lo, hi, plot_h);
+        // Right-aligned; a label wider than the column loses its left end.
+        let w = label_w as usize;
+        let n = label.chars().count();
+        let text: String = if n > w {
+            label.chars().skip(n - w).collect()
+        } else {
+            format!("{label:>w$}")
+        };
+        buf.set_string(area.x, y, text, theme.dim);
+    }
 }
 
 fn figures_panel(
