@@ -148,3 +148,15 @@ pub fn help_lines() -> Vec<(&'static str, &'static str, Scope)> {
         .map(|b| (b.keys, b.help, b.scope))
         .collect()
 }
+
+/// What the trial screen's figure columns mean (the help lists them after
+/// the keys): (label, meaning).
+pub const FIGURE_LEGEND: &[(&str, &str)] = &[
+    ("out%b", "% outside the limits, before"),
+    ("out%a", "% outside, after (variant)"),
+    ("exc b", "mean excursion, deg, before"),
+    ("exc a", "mean excursion, deg, after"),
+    ("shift", "mean |corrected - raw|, deg"),
+    ("corr", "mean correction angle, deg"),
+    ("exc", "joints: X+Y+Z excursion, deg"),
+];

@@ -3,7 +3,7 @@
 
 use super::app::{App, Overlay};
 use super::cells::centred;
-use super::keymap::{help_lines, Scope};
+use super::keymap::{help_lines, Scope, FIGURE_LEGEND};
 use super::msg::Screen;
 use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
 use super::theme::Theme;
@@ -159,6 +159,14 @@ fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
                 Span::raw(text),
             ]));
         }
+    }
+    headings.push(items.len());
+    items.push(Line::from(Span::styled("trial figures", theme.header)));
+    for (label, text) in FIGURE_LEGEND {
+        items.push(Line::from(vec![
+            Span::styled(format!(" {label:<6}"), theme.title),
+            Span::raw(*text),
+        ]));
     }
     // Two columns when the list is taller than the screen.
     let inner_h = body.height.saturating_sub(3) as usize;

@@ -3,7 +3,7 @@
 //! [`SyncRunner`]; nothing sleeps.
 
 use super::app::{update, App, Msg, Overlay};
-use super::headless::{draw, load_app, show, write_demo_folder, Show, SCREENS};
+use super::headless::{buffer_ansi, draw, load_app, show, write_demo_folder, Show, SCREENS};
 use super::jobs::SyncRunner;
 use super::msg::Screen;
 use super::render::render;
@@ -15,7 +15,7 @@ use ratatui::Terminal;
 use std::path::Path;
 
 /// Sizes every screen is checked at.
-pub const SIZES: [(u16, u16); 2] = [(80, 24), (120, 40)];
+pub const SIZES: [(u16, u16); 3] = [(60, 20), (80, 24), (120, 40)];
 
 pub(super) struct Fixture {
     tmp: tempfile::TempDir,
@@ -65,6 +65,19 @@ pub(super) fn snap(name: &str, app: &App) {
     }
 }
 
+/// Style snapshots (ANSI SGR per cell): under `NO_COLOR` at every size,
+/// where only glyphs and modifiers tell things apart, and in colour at
+/// 80x24.
+pub(super) fn snap_styled(name: &str, app: &App) {
+    let plain = Theme::builtin("dark", true).unwrap();
+    for (w, h) in SIZES {
+        let text = buffer_ansi(&draw(app, &plain, w, h));
+        insta::assert_snapshot!(format!("{name}_nocolor_{w}x{h}"), text);
+    }
+    let text = buffer_ansi(&draw(app, &Theme::default(), 80, 24));
+    insta::assert_snapshot!(format!("{name}_colour_80x24"), text);
+}
+
 fn shown(app: &mut App, screen: &str, trial: &str) {
     show(
         app,
@@ -85,6 +98,7 @@ fn screens() {
         let mut app = fx.app();
         shown(&mut app, screen, "knee.csv");
         snap(screen, &app);
+        snap_styled(screen, &app);
     }
 }
 
@@ -392,4 +406,87 @@ fn tiny_sizes_never_panic() {
             let _ = draw(&app, &Theme::default(), w, h);
         }
     }
+}
+
+/// Under `NO_COLOR` the trial screen still tells raw, corrected and the
+/// limits apart (by glyph, named in the legend), its three charts share one
+/// plot column, and the y ticks are round values in degrees.
+#[test]
+fn trial_charts_read_without_colour() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    shown(&mut app, "trial", "knee.csv");
+    let plain = Theme::builtin("dark", true).unwrap();
+    let is_braille = |c: char| ('\u{2801}'..='\u{28ff}').contains(&c);
+    for (w, h) in SIZES {
+        let buf = draw(&app, &plain, w, h);
+        assert!(buf
+            .content
+            .iter()
+            .all(|c| c.fg == ratatui::style::Color::Reset && c.bg == ratatui::style::Color::Reset));
+        let text = super::headless::buffer_text(&buf);
+        // The legend, shortened where the full one does not fit.
+        let items = if w >= 80 {
+            ["⠒⠒ raw", "▄▀ drift", "══ limits", "┊ cursor"]
+        } else {
+            ["⠒raw", "▄drift", "═lim", "┊cur"]
+        };
+        let legend = text.lines().find(|l| l.contains(items[0])).expect("legend");
+        for item in items {
+            assert!(legend.contains(item), "{w}x{h}: {legend}");
+        }
+        let plot: String = text.lines().filter(|l| l.contains("°│")).collect();
+        assert!(plot.chars().any(is_braille), "raw in braille");
+        assert!(
+            plot.contains('▄') || plot.contains('▀'),
+            "corrected in half blocks"
+        );
+        assert!(plot.contains('═'), "limit lines");
+        // Every tick ends its label at the same column, a multiple of 10 deg
+        // here (the knee's angles span tens of degrees).
+        let mut columns = std::collections::BTreeSet::new();
+        let mut ticks = 0;
+        for line in text.lines() {
+            let chars: Vec<char> = line.chars().collect();
+            if let Some(k) = chars.windows(2).position(|p| p == ['°', '│']) {
+                columns.insert(k);
+                let start = chars[..k]
+                    .iter()
+                    .rposition(|c| *c == ' ' || *c == '│')
+                    .unwrap()
+                    + 1;
+                let v: f64 = chars[start..k].iter().collect::<String>().parse().unwrap();
+                assert_eq!(v % 10.0, 0.0, "{line}");
+                ticks += 1;
+            }
+        }
+        assert_eq!(columns.len(), 1, "{w}x{h}: plot areas aligned\n{text}");
+        assert!(ticks >= 3, "{w}x{h}: {ticks} ticks");
+        assert!(text.contains("at cursor raw"), "cursor values labelled");
+    }
+    // ASCII: nothing but ASCII in the plots and the legend.
+    let ascii = Theme::default().with_ascii(true);
+    let text = super::headless::buffer_text(&draw(&app, &ascii, 80, 24));
+    assert!(
+        !text
+            .chars()
+            .any(|c| is_braille(c) || "▄▀█•═┄┊×".contains(c)),
+        "{text}"
+    );
+    assert!(text.contains(".. raw  ** drift  == limits"), "{text}");
+}
+
+#[test]
+fn ticks_are_round_and_few() {
+    use super::screens::trial::ticks;
+    assert_eq!(ticks(-7.2, 136.4, 5), (50.0, vec![0.0, 50.0, 100.0]));
+    assert_eq!(
+        ticks(-7.2, 136.4, 8).1,
+        vec![0.0, 20.0, 40.0, 60.0, 80.0, 100.0, 120.0]
+    );
+    let (step, v) = ticks(-0.8, 0.9, 4);
+    assert_eq!(step, 0.5);
+    assert_eq!(v, vec![-0.5, 0.0, 0.5]);
+    assert!(ticks(f64::NAN, 1.0, 3).1.is_empty());
+    assert_eq!(ticks(3.0, 3.5, 1).1, vec![3.0]);
 }

@@ -85,18 +85,35 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     }
     f.render_widget(Paragraph::new(lines), table);
     let mut msg = vec![];
+    // An edit of lambda2 changes the joint's three rows: said before it is made.
+    let whole_joint = joint_wide(app).map(|j| {
+        Span::styled(
+            format!("  lambda2 is one per joint: applies to {j}'s three rows (X, Y, Z)"),
+            theme.warn,
+        )
+    });
     match &l.edit {
         Some(e) => match &e.error {
             Some(m) => msg.push(Line::from(Span::styled(
                 format!("x invalid: {m}"),
                 theme.invalid,
             ))),
-            None => msg.push(Line::from(Span::styled("ok: Enter commits", theme.ok))),
+            None => msg.push(Line::from(
+                [Span::styled("ok: Enter commits", theme.ok)]
+                    .into_iter()
+                    .chain(whole_joint)
+                    .collect::<Vec<_>>(),
+            )),
         },
-        None => msg.push(Line::from(Span::styled(
-            "Enter edits the cell; edits re-run the open trial's joints",
-            theme.dim,
-        ))),
+        None => msg.push(Line::from(
+            [Span::styled(
+                "Enter edits the cell; edits re-run the open trial's joints",
+                theme.dim,
+            )]
+            .into_iter()
+            .chain(whole_joint)
+            .collect::<Vec<_>>(),
+        )),
     }
     f.render_widget(
         Paragraph::new(msg)
@@ -104,6 +121,16 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
             .block(Block::new().borders(Borders::TOP)),
         foot,
     );
+}
+
+/// The joint whose three rows the selected cell's edit changes (the
+/// lambda2 column), if it is such a cell.
+fn joint_wide(app: &Workbench) -> Option<&str> {
+    let l = &app.limits;
+    if l.col != 6 {
+        return None;
+    }
+    l.table.rows.get(l.row).map(|r| r.joint.as_str())
 }
 
 fn cell_spans(
@@ -234,14 +261,25 @@ pub fn edit_key(app: &mut Workbench, k: KeyEvent) -> Reply {
             match applied {
                 Ok((table, settings)) => {
                     let settings_changed = settings != l.settings;
+                    let mut note = None;
                     if let Some(r) = l.table.rows.get(l.row) {
                         l.pending.get_or_insert_with(Vec::new).push(r.joint.clone());
+                        if l.col == 6 {
+                            note = Some(format!(
+                                "lambda2 of {} set to {} on its three rows",
+                                r.joint,
+                                text.trim()
+                            ));
+                        }
                     }
                     l.pending_all |= settings_changed;
                     l.table = table;
                     l.settings = settings;
                     l.edit = None;
                     app.settings = app.limits.settings.settings();
+                    if let Some(n) = note {
+                        app.info(n);
+                    }
                     return vec![Effect::Debounce].into();
                 }
                 Err(m) => {

@@ -53,7 +53,12 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         f.render_widget(Paragraph::new("trial not loaded"), area);
         return;
     };
-    let left_w = if area.width >= 100 { 32 } else { 26 }.min(area.width / 2);
+    let left_w = match area.width {
+        100.. => 32,
+        80.. => 26,
+        _ => 22,
+    }
+    .min(area.width / 2);
     let [left, right] =
         Layout::horizontal([Constraint::Length(left_w), Constraint::Min(1)]).areas(area);
     let figs_h = 9.min(left.height / 2);
@@ -179,30 +184,56 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         }
         chart(f, parts[axis], theme, Line::from(title), d, fr, label_w);
     }
-    let mut legend = vec![(sample(glyphs.raw), "raw".to_string(), theme.raw)];
+    // (glyph, name, short name, style) of what the charts show.
+    let mut legend = vec![(sample(glyphs.raw), "raw".to_string(), "", theme.raw)];
     if cor.is_some() {
         legend.push((
             sample(glyphs.corrected),
             app.variant.to_string(),
+            "",
             theme.corrected,
         ));
     }
     if lim.is_some() {
-        legend.push((sample(glyphs.limit), "limits".into(), theme.limit));
+        legend.push((sample(glyphs.limit), "limits".into(), "lim", theme.limit));
     }
     if lim.is_some_and(|l| l.centroid_deg.is_some()) {
-        legend.push((sample(glyphs.centroid), "centroid".into(), theme.centroid));
+        legend.push((
+            sample(glyphs.centroid),
+            "centroid".into(),
+            "cen",
+            theme.centroid,
+        ));
     }
     // A vertical line: one of its glyph.
     let cursor: String = sample(glyphs.cursor).chars().take(1).collect();
-    legend.push((cursor, "cursor".into(), theme.cursor));
+    legend.push((cursor, "cursor".into(), "cur", theme.cursor));
     if !glitches.is_empty() {
-        legend.push((sample(glyphs.glitch), "glitch".into(), theme.warn));
+        legend.push((sample(glyphs.glitch), "glitch".into(), "gl", theme.warn));
     }
+    let full: usize = legend
+        .iter()
+        .map(|(g, n, _, _)| g.chars().count() + n.chars().count() + 3)
+        .sum::<usize>()
+        + 1;
     let mut spans = vec![Span::raw(" ")];
-    for (glyph, name, style) in legend {
-        spans.push(Span::styled(glyph, style));
-        spans.push(Span::raw(format!(" {name}  ")));
+    for (glyph, name, short, style) in legend {
+        if full <= legend_row.width as usize {
+            spans.push(Span::styled(glyph, style));
+            spans.push(Span::raw(format!(" {name}  ")));
+        } else {
+            // Narrow: one glyph and a short name each.
+            spans.push(Span::styled(
+                glyph.chars().take(1).collect::<String>(),
+                style,
+            ));
+            let name = if short.is_empty() {
+                name
+            } else {
+                short.to_string()
+            };
+            spans.push(Span::raw(format!("{name} ")));
+        }
     }
     f.render_widget(Paragraph::new(Line::from(spans)), legend_row);
     let note = e
@@ -217,18 +248,31 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     } else {
         "not run: r runs all variants".to_string()
     };
+    // A running correction first: it must not be cut at narrow widths; the
+    // span and cursor shorter there.
+    let zoom = 1u32 << app.view.zoom.min(16);
+    let (running, done) = if e.running.is_some() {
+        (format!(" {status} "), String::new())
+    } else {
+        (String::new(), status)
+    };
+    let place = if foot.width >= 60 {
+        format!(
+            " t {s0:.1}-{s1:.1} s  x{zoom}  cursor {:.2} s  ",
+            app.view.cursor_s
+        )
+    } else {
+        format!(" {s0:.0}-{s1:.0}s x{zoom} @{:.2}s ", app.view.cursor_s)
+    };
     f.render_widget(
         Paragraph::new(Line::from(vec![
-            Span::raw(format!(
-                " t {s0:.1}-{s1:.1} s  x{}  cursor {:.2} s  ",
-                1u32 << app.view.zoom.min(16),
-                app.view.cursor_s
-            )),
+            Span::styled(running, theme.warn),
+            Span::raw(place),
             Span::styled(
                 crate::ui::glitches::footer(&glitches, app.view.cursor_s).unwrap_or_default(),
                 theme.warn,
             ),
-            Span::styled(status, theme.dim),
+            Span::styled(done, theme.dim),
             Span::styled(note.unwrap_or_default(), theme.warn),
             Span::styled(
                 crate::ui::pose::label(l)
@@ -457,16 +501,23 @@ fn figures_panel(
 ) {
     let before = figures_of(e.figures(None), joint);
     let after = figures_of(e.figures(Some(app.variant)), joint);
+    // Number columns as wide as the panel allows (6, or 5 when narrow).
+    let nw = (area.width.saturating_sub(7) as usize / 3).clamp(4, 6);
+    // One decimal while a space is left before the number, else none.
+    let cell = |v: Option<f64>| match v {
+        Some(v) if v.is_finite() && format!("{v:.1}").len() >= nw => format!("{v:>nw$.0}"),
+        v => num(v, nw),
+    };
     let row = |label: &str, v: Option<[f64; 3]>| {
         let mut s = format!("{label:<6}");
         for k in 0..3 {
-            s.push_str(&num(v.map(|v| v[k]), 6));
+            s.push_str(&cell(v.map(|v| v[k])));
         }
         Line::from(s)
     };
     let mut lines = vec![
         Line::from(Span::styled(
-            format!("{:<6}{:>6}{:>6}{:>6}", "deg", "X", "Y", "Z"),
+            format!("{:<6}{:>nw$}{:>nw$}{:>nw$}", "deg", "X", "Y", "Z"),
             theme.header,
         )),
         row("out%b", before.map(|f| f.excursion.pct_outside)),
@@ -483,18 +534,17 @@ fn figures_panel(
     lines.push(Line::from(format!(
         "{:<6}{}",
         "corr",
-        num(
+        cell(
             after
                 .and_then(|f| f.shift.as_ref())
-                .map(|s| s.mean_correction_angle_deg),
-            6
+                .map(|s| s.mean_correction_angle_deg)
         )
     )));
     f.render_widget(
         Paragraph::new(lines).block(
             Block::new()
                 .borders(Borders::TOP | Borders::RIGHT)
-                .title(" figures "),
+                .title(" figures (? legend) "),
         ),
         area,
     );
