@@ -45,6 +45,10 @@ pub struct App {
     pub calib: CalibState,
     /// The histogram screen, once opened.
     pub histogram: Option<HistogramState>,
+    /// First line of the help shown, and the largest that still fills it at
+    /// the size last drawn (kept by the drawing).
+    pub help_scroll: usize,
+    pub help_max: std::cell::Cell<usize>,
 }
 
 impl std::ops::Deref for App {
@@ -73,6 +77,8 @@ impl App {
             views: Default::default(),
             calib: Default::default(),
             histogram: None,
+            help_scroll: 0,
+            help_max: Default::default(),
         }
     }
 }
@@ -336,6 +342,14 @@ fn recorrect_now(app: &mut App) -> Vec<Effect> {
 }
 
 fn key(app: &mut App, k: KeyEvent) -> Vec<Effect> {
+    // Esc and the next key pressed at once arrive as one Alt-key (the
+    // terminal sends ESC then the key): both are carried out.
+    if k.modifiers.contains(KeyModifiers::ALT) && !k.modifiers.contains(KeyModifiers::CONTROL) {
+        let mut effects = key(app, KeyEvent::from(KeyCode::Esc));
+        let plain = KeyEvent::new(k.code, k.modifiers - KeyModifiers::ALT);
+        effects.extend(key(app, plain));
+        return effects;
+    }
     // Text entry first: the filter and the cell editor take characters
     // (all but Ctrl-C, which quits from anywhere).
     let quit = k.modifiers.contains(KeyModifiers::CONTROL) && k.code == KeyCode::Char('c');
@@ -416,8 +430,24 @@ pub fn wants_ticks(app: &App) -> bool {
 fn action(app: &mut App, a: Action) -> Vec<Effect> {
     // Overlays answer first.
     match (&app.overlay, a) {
-        (Some(Overlay::Help), Action::Quit) => {
-            app.overlay = None;
+        (
+            Some(Overlay::Help),
+            Action::Up
+            | Action::Down
+            | Action::PageUp
+            | Action::PageDown
+            | Action::Home
+            | Action::End,
+        ) => {
+            let (at, max) = (app.help_scroll.min(app.help_max.get()), app.help_max.get());
+            app.help_scroll = match a {
+                Action::Up => at.saturating_sub(1),
+                Action::Down => (at + 1).min(max),
+                Action::PageUp => at.saturating_sub(10),
+                Action::PageDown => (at + 10).min(max),
+                Action::Home => 0,
+                _ => max,
+            };
             return vec![];
         }
         (Some(Overlay::Help), _) => {
@@ -455,6 +485,7 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
     match a {
         Action::Help => {
             app.overlay = Some(Overlay::Help);
+            app.help_scroll = 0;
             return vec![];
         }
         Action::Quit => {

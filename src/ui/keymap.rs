@@ -56,6 +56,8 @@ pub enum Scope {
     Compare,
     Limits,
     Views,
+    Calibration,
+    Histogram,
 }
 
 impl Scope {
@@ -67,6 +69,8 @@ impl Scope {
             Scope::Compare => "compare",
             Scope::Limits => "limits",
             Scope::Views => "views",
+            Scope::Calibration => "calibration",
+            Scope::Histogram => "histograms",
         }
     }
 }
@@ -86,9 +90,9 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "q", code: &[KeyCode::Char('q')], action: Action::Quit, scope: Scope::Everywhere, help: "quit (asks if unsaved)" },
     Binding { keys: "?", code: &[KeyCode::Char('?'), KeyCode::F(1)], action: Action::Help, scope: Scope::Everywhere, help: "this help" },
     Binding { keys: "Esc", code: &[KeyCode::Esc, KeyCode::Backspace], action: Action::Back, scope: Scope::Everywhere, help: "back / cancel" },
-    Binding { keys: "Up/Down", code: &[KeyCode::Up, KeyCode::Char('k')], action: Action::Up, scope: Scope::Everywhere, help: "move selection" },
+    Binding { keys: "Up/Down j/k", code: &[KeyCode::Up, KeyCode::Char('k')], action: Action::Up, scope: Scope::Everywhere, help: "move selection" },
     Binding { keys: "", code: &[KeyCode::Down, KeyCode::Char('j')], action: Action::Down, scope: Scope::Everywhere, help: "" },
-    Binding { keys: "PgUp/PgDn", code: &[KeyCode::PageUp], action: Action::PageUp, scope: Scope::Everywhere, help: "page" },
+    Binding { keys: "PgUp/PgDn", code: &[KeyCode::PageUp], action: Action::PageUp, scope: Scope::Everywhere, help: "a page up / down" },
     Binding { keys: "", code: &[KeyCode::PageDown], action: Action::PageDown, scope: Scope::Everywhere, help: "" },
     Binding { keys: "Enter", code: &[KeyCode::Enter], action: Action::Enter, scope: Scope::Everywhere, help: "open / edit / commit" },
     Binding { keys: "/", code: &[KeyCode::Char('/')], action: Action::Filter, scope: Scope::Trials, help: "filter by name" },
@@ -98,15 +102,15 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "r", code: &[KeyCode::Char('r')], action: Action::Run, scope: Scope::Trial, help: "run all variants" },
     Binding { keys: "v", code: &[KeyCode::Char('v')], action: Action::Variant, scope: Scope::Trial, help: "next variant" },
     Binding { keys: "c", code: &[KeyCode::Char('c')], action: Action::Compare, scope: Scope::Trial, help: "compare and save" },
-    Binding { keys: "l", code: &[KeyCode::Char('l')], action: Action::Limits, scope: Scope::Everywhere, help: "limits editor" },
+    Binding { keys: "L", code: &[KeyCode::Char('L')], action: Action::Limits, scope: Scope::Everywhere, help: "limits editor" },
     Binding { keys: "+/-", code: &[KeyCode::Char('+'), KeyCode::Char('=')], action: Action::ZoomIn, scope: Scope::Trial, help: "zoom (or mouse wheel)" },
     Binding { keys: "", code: &[KeyCode::Char('-')], action: Action::ZoomOut, scope: Scope::Trial, help: "" },
-    Binding { keys: "Left/Right", code: &[KeyCode::Left, KeyCode::Char('h')], action: Action::Left, scope: Scope::Trial, help: "pan time / pick column" },
-    Binding { keys: "", code: &[KeyCode::Right], action: Action::Right, scope: Scope::Trial, help: "" },
+    Binding { keys: "Left/Right h/l", code: &[KeyCode::Left, KeyCode::Char('h')], action: Action::Left, scope: Scope::Everywhere, help: "left / right (pan, column)" },
+    Binding { keys: "", code: &[KeyCode::Right, KeyCode::Char('l')], action: Action::Right, scope: Scope::Everywhere, help: "" },
     Binding { keys: ", .", code: &[KeyCode::Char(',')], action: Action::CursorLeft, scope: Scope::Trial, help: "move the cursor" },
     Binding { keys: "", code: &[KeyCode::Char('.')], action: Action::CursorRight, scope: Scope::Trial, help: "" },
-    Binding { keys: "Home/End", code: &[KeyCode::Home], action: Action::Home, scope: Scope::Trial, help: "cursor to start / end" },
-    Binding { keys: "", code: &[KeyCode::End], action: Action::End, scope: Scope::Trial, help: "" },
+    Binding { keys: "Home/End", code: &[KeyCode::Home], action: Action::Home, scope: Scope::Everywhere, help: "first / last (trial: cursor)" },
+    Binding { keys: "", code: &[KeyCode::End], action: Action::End, scope: Scope::Everywhere, help: "" },
     Binding { keys: "m", code: &[KeyCode::Char('m')], action: Action::Marker, scope: Scope::Trial, help: "braille / dot marker" },
     Binding { keys: "P", code: &[KeyCode::Char('P')], action: Action::Pose, scope: Scope::Trial, help: "pose calibration at cursor" },
     Binding { keys: "G", code: &[KeyCode::Char('G')], action: Action::NextGlitch, scope: Scope::Trial, help: "cursor to the next glitch" },
@@ -123,6 +127,13 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "p", code: &[KeyCode::Char('p')], action: Action::Play, scope: Scope::Views, help: "play / pause (or Space)" },
     Binding { keys: "y / n", code: &[KeyCode::Char('y')], action: Action::Yes, scope: Scope::Everywhere, help: "answer a question" },
     Binding { keys: "", code: &[KeyCode::Char('n')], action: Action::No, scope: Scope::Everywhere, help: "" },
+    // What keys bound above do on two more screens (for their help).
+    Binding { keys: "r", code: &[KeyCode::Char('r')], action: Action::Run, scope: Scope::Calibration, help: "read the recordings again" },
+    Binding { keys: "Enter", code: &[KeyCode::Enter], action: Action::Enter, scope: Scope::Histogram, help: "suggest limits (90% intervals)" },
+    Binding { keys: "w", code: &[KeyCode::Char('w')], action: Action::Save, scope: Scope::Histogram, help: "write centroids.csv (asks)" },
+    Binding { keys: "Left/Right", code: &[KeyCode::Left], action: Action::Left, scope: Scope::Histogram, help: "previous / next span" },
+    Binding { keys: "+/-", code: &[KeyCode::Char('+')], action: Action::ZoomIn, scope: Scope::Histogram, help: "span length" },
+    Binding { keys: "Home/End", code: &[KeyCode::Home], action: Action::Home, scope: Scope::Histogram, help: "first 30 s / whole trial" },
 ];
 
 /// The action of a key press, if any. Of the Ctrl-combinations only Ctrl-C

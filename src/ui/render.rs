@@ -135,71 +135,70 @@ fn popup(f: &mut Frame, theme: &Theme, area: Rect, title: &str, lines: Vec<Line>
     );
 }
 
-fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
-    let order = [
-        Scope::Everywhere,
-        Scope::Trials,
-        Scope::Trial,
-        Scope::Compare,
-        Scope::Limits,
-        Scope::Views,
-    ];
+/// The help's sections for the screen in front: the keys that work
+/// everywhere, the screen's own, and (trial screen) what its figures mean.
+pub fn help_items(screen: Screen, theme: &Theme) -> Vec<Line<'static>> {
+    let own = match screen {
+        Screen::Trials => Scope::Trials,
+        Screen::Trial => Scope::Trial,
+        Screen::Compare => Scope::Compare,
+        Screen::Limits => Scope::Limits,
+        Screen::Views => Scope::Views,
+        Screen::Calibration => Scope::Calibration,
+        Screen::Histogram => Scope::Histogram,
+    };
     let mut items: Vec<Line> = vec![];
-    let mut headings = vec![];
-    for scope in order {
+    for scope in [own, Scope::Everywhere] {
         let entries: Vec<_> = help_lines().into_iter().filter(|l| l.2 == scope).collect();
         if entries.is_empty() {
             continue;
         }
-        headings.push(items.len());
         items.push(Line::from(Span::styled(scope.title(), theme.header)));
         for (keys, text, _) in entries {
             items.push(Line::from(vec![
-                Span::styled(format!(" {keys:<11}"), theme.title),
+                Span::styled(format!(" {keys:<15}"), theme.title),
                 Span::raw(text),
             ]));
         }
     }
-    headings.push(items.len());
-    items.push(Line::from(Span::styled("trial figures", theme.header)));
-    for (label, text) in FIGURE_LEGEND {
-        items.push(Line::from(vec![
-            Span::styled(format!(" {label:<6}"), theme.title),
-            Span::raw(*text),
-        ]));
-    }
-    // Two columns when the list is taller than the screen.
-    let inner_h = body.height.saturating_sub(3) as usize;
-    let two = items.len() > inner_h && body.width >= 78;
-    // A heading never ends the left column: it moves to the right one.
-    if two {
-        let half = items.len().div_ceil(2);
-        if headings.contains(&(half - 1)) {
-            items.insert(half - 1, Line::default());
+    if screen == Screen::Trial {
+        items.push(Line::from(Span::styled("figures", theme.header)));
+        for (label, text) in FIGURE_LEGEND {
+            items.push(Line::from(vec![
+                Span::styled(format!(" {label:<15}"), theme.title),
+                Span::raw(*text),
+            ]));
         }
     }
-    let w = if two { 78 } else { 50 };
-    let rows = if two {
-        items.len().div_ceil(2)
+    items
+}
+
+fn help(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
+    let items = help_items(app.screen, theme);
+    let n = items.len();
+    let area = centred(body, 62, n as u16 + 2);
+    let inner_h = area.height.saturating_sub(2) as usize;
+    let max = n.saturating_sub(inner_h);
+    app.help_max.set(max);
+    let first = app.help_scroll.min(max);
+    let title = if max == 0 {
+        " Keys (any key closes) ".to_string()
     } else {
-        items.len()
+        format!(
+            " Keys {}-{} of {n} (Up/Down PgUp/PgDn scroll, other keys close) ",
+            first + 1,
+            (first + inner_h).min(n)
+        )
     };
-    let area = centred(body, w, rows as u16 + 2);
     f.render_widget(Clear, area);
-    let block = Block::new()
-        .borders(Borders::ALL)
-        .title(Span::styled(" Keys (any key closes) ", theme.title));
-    let inner = block.inner(area);
-    f.render_widget(block, area);
-    if two {
-        let half = items.len().div_ceil(2);
-        let right = items.split_off(half);
-        let [a, b] = Layout::horizontal([Constraint::Ratio(1, 2); 2]).areas(inner);
-        f.render_widget(Paragraph::new(items), a);
-        f.render_widget(Paragraph::new(right), b);
-    } else {
-        f.render_widget(Paragraph::new(items), inner);
-    }
+    f.render_widget(
+        Paragraph::new(items.into_iter().skip(first).collect::<Vec<_>>()).block(
+            Block::new()
+                .borders(Borders::ALL)
+                .title(Span::styled(title, theme.title)),
+        ),
+        area,
+    );
 }
 
 fn quit_confirm(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {

@@ -490,3 +490,88 @@ fn ticks_are_round_and_few() {
     assert!(ticks(f64::NAN, 1.0, 3).1.is_empty());
     assert_eq!(ticks(3.0, 3.5, 1).1, vec![3.0]);
 }
+
+/// Clears the cell being edited and types `text`.
+fn retype(app: &mut App, text: &str) {
+    use ratatui::crossterm::event::KeyModifiers;
+    let ctrl_u = KeyEvent::new(KeyCode::Char('u'), KeyModifiers::CONTROL);
+    SyncRunner::send(app, Msg::Key(ctrl_u));
+    keys(app, text);
+}
+
+fn edit_error(app: &App) -> Option<String> {
+    app.limits.edit.as_ref().and_then(|e| e.error.clone())
+}
+
+#[test]
+fn limits_editor_keeps_centroids_inside_and_lambda2_in_range() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    keys(&mut app, "l");
+    assert_eq!(app.screen, Screen::Limits);
+    let row = |app: &App, joint: &str, axis: usize| {
+        app.limits
+            .table
+            .rows
+            .iter()
+            .position(|r| r.joint == joint && r.axis == axis)
+            .unwrap()
+    };
+    // Hip Y: -30..100, centroid 12 (Table 3-2, Table 3-3).
+    app.limits.row = row(&app, "hip", 1);
+    app.limits.col = 5;
+    key(&mut app, KeyCode::Enter);
+    retype(&mut app, "110");
+    let e = edit_error(&app).expect("rejected");
+    assert!(
+        e.contains("centroid 110 must lie within the limits [-30, 100]"),
+        "{e}"
+    );
+    key(&mut app, KeyCode::Enter);
+    assert!(app.limits.edit.is_some(), "not committed");
+    key(&mut app, KeyCode::Esc);
+    // Limits moved past the centroid: the same rule.
+    app.limits.col = 4;
+    key(&mut app, KeyCode::Enter);
+    retype(&mut app, "10");
+    let e = edit_error(&app).expect("rejected");
+    assert!(
+        e.contains("centroid 12 must lie within the limits [-30, 10]"),
+        "{e}"
+    );
+    key(&mut app, KeyCode::Esc);
+    // lambda2: a stated range, and the joint's three rows, said before and after.
+    app.limits.col = 6;
+    let text = super::headless::buffer_text(&draw(&app, &Theme::default(), 120, 40));
+    assert!(text.contains("applies to hip's three rows"), "{text}");
+    key(&mut app, KeyCode::Enter);
+    retype(&mut app, "1e9");
+    let e = edit_error(&app).expect("rejected");
+    assert!(e.contains("within 0..1000"), "{e}");
+    retype(&mut app, "40");
+    assert_eq!(edit_error(&app), None);
+    key(&mut app, KeyCode::Enter);
+    let hips: Vec<f64> = app
+        .limits
+        .table
+        .rows
+        .iter()
+        .filter(|r| r.joint == "hip")
+        .map(|r| r.lambda2)
+        .collect();
+    assert_eq!(hips, [40.0; 3]);
+    let (m, _) = app.message.clone().unwrap();
+    assert!(
+        m.contains("lambda2 of hip set to 40 on its three rows"),
+        "{m}"
+    );
+    // Only where a centroid is set: the knee has none.
+    app.limits.row = row(&app, "knee", 1);
+    key(&mut app, KeyCode::Enter);
+    retype(&mut app, "30");
+    let e = edit_error(&app).expect("rejected");
+    assert!(e.contains("knee has none"), "{e}");
+    retype(&mut app, "0");
+    assert_eq!(edit_error(&app), None);
+    key(&mut app, KeyCode::Esc);
+}

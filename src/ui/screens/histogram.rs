@@ -613,6 +613,22 @@ mod tests {
             c.contains("\njoint,axis,centroid_deg,sd_deg,samples,trials\nback,X,"),
             "{c}"
         );
+        // w again: the file exists, so it asks; n keeps it, y overwrites.
+        let path = root.join("joint_limits/centroids.csv");
+        std::fs::write(&path, "mine\n").unwrap();
+        key(&mut app, KeyCode::Char('w'));
+        assert!(app.histogram.as_ref().unwrap().overwrite.is_some());
+        let text = buffer_text(&draw(&app, &Theme::default(), 80, 24));
+        assert!(
+            text.contains("centroids.csv exists") && text.contains("y overwrite"),
+            "{text}"
+        );
+        key(&mut app, KeyCode::Char('n'));
+        assert!(app.histogram.as_ref().unwrap().overwrite.is_none());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "mine\n");
+        key(&mut app, KeyCode::Char('w'));
+        key(&mut app, KeyCode::Char('y'));
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), c);
         // The next 30 s of a 30 s trial hold nothing; Home comes back.
         key(&mut app, KeyCode::Right);
         assert!(app.histogram.as_ref().unwrap().hists.is_empty());
