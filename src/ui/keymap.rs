@@ -127,7 +127,12 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "p", code: &[KeyCode::Char('p')], action: Action::Play, scope: Scope::Views, help: "play / pause (or Space)" },
     Binding { keys: "y / n", code: &[KeyCode::Char('y')], action: Action::Yes, scope: Scope::Everywhere, help: "answer a question" },
     Binding { keys: "", code: &[KeyCode::Char('n')], action: Action::No, scope: Scope::Everywhere, help: "" },
-    // What keys bound above do on two more screens (for their help).
+    // What keys bound above do on other screens (for their help).
+    Binding { keys: "r", code: &[KeyCode::Char('r')], action: Action::Run, scope: Scope::Trials, help: "run all variants of the selected" },
+    Binding { keys: "v", code: &[KeyCode::Char('v')], action: Action::Variant, scope: Scope::Trials, help: "next variant" },
+    Binding { keys: "H", code: &[KeyCode::Char('H')], action: Action::Histogram, scope: Scope::Trials, help: "histograms of the listed trials" },
+    Binding { keys: "Left/Right", code: &[KeyCode::Left], action: Action::Left, scope: Scope::Compare, help: "pick the variant column" },
+    Binding { keys: "w", code: &[KeyCode::Char('w')], action: Action::Save, scope: Scope::Compare, help: "save the chosen variant" },
     Binding { keys: "r", code: &[KeyCode::Char('r')], action: Action::Run, scope: Scope::Calibration, help: "read the recordings again" },
     Binding { keys: "Enter", code: &[KeyCode::Enter], action: Action::Enter, scope: Scope::Histogram, help: "suggest limits (90% intervals)" },
     Binding { keys: "w", code: &[KeyCode::Char('w')], action: Action::Save, scope: Scope::Histogram, help: "write centroids.csv (asks)" },

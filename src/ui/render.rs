@@ -94,7 +94,7 @@ pub fn hints(app: &App) -> &'static str {
     }
     match app.screen {
         Screen::Trials => {
-            "Enter open  r run  / filter  s sort  v variant  l limits  ? help  q quit"
+            "Enter open  r run  / filter  s sort  v variant  L limits  ? help  q quit"
         }
         Screen::Trial => {
             "r run  v variant  c compare  +- zoom  <- -> pan  , . cursor  x o a f D views  ? help"

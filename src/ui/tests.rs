@@ -283,7 +283,7 @@ fn compare_scrolls_to_the_baselines_and_saves_one() {
 fn limits_app(fx: &Fixture) -> App {
     let mut app = fx.app();
     shown(&mut app, "trial", "knee.csv");
-    keys(&mut app, "l");
+    keys(&mut app, "L");
     assert_eq!(app.screen, Screen::Limits);
     // knee, Y, upper.
     app.limits.row = app
@@ -507,7 +507,7 @@ fn edit_error(app: &App) -> Option<String> {
 fn limits_editor_keeps_centroids_inside_and_lambda2_in_range() {
     let fx = Fixture::new();
     let mut app = fx.app();
-    keys(&mut app, "l");
+    keys(&mut app, "L");
     assert_eq!(app.screen, Screen::Limits);
     let row = |app: &App, joint: &str, axis: usize| {
         app.limits
@@ -574,4 +574,52 @@ fn limits_editor_keeps_centroids_inside_and_lambda2_in_range() {
     retype(&mut app, "0");
     assert_eq!(edit_error(&app), None);
     key(&mut app, KeyCode::Esc);
+}
+
+/// Keys that move through lists and the help: Home/End and a counter on
+/// the trials list, h/l as Left/Right, Esc pressed together with the next
+/// key (an Alt-key) carried out as both, and the help scrolling at 60x20.
+#[test]
+fn lists_help_and_keys_after_esc() {
+    use ratatui::crossterm::event::KeyModifiers;
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    let text = |app: &App, w, h| super::headless::buffer_text(&draw(app, &Theme::default(), w, h));
+    assert!(text(&app, 80, 24).contains("trial 1/3 (sort: name)"));
+    key(&mut app, KeyCode::End);
+    assert_eq!(app.selected, 2);
+    assert!(text(&app, 80, 24).contains("trial 3/3 (sort: name)"));
+    key(&mut app, KeyCode::Home);
+    assert_eq!(app.selected, 0);
+    // Esc and `s` at once: the filter ends, then the list is sorted.
+    keys(&mut app, "/kn");
+    assert!(app.filter_editing);
+    SyncRunner::send(
+        &mut app,
+        Msg::Key(KeyEvent::new(KeyCode::Char('s'), KeyModifiers::ALT)),
+    );
+    assert!(!app.filter_editing);
+    assert_eq!(app.sort, super::app::SortKey::Duration);
+    // h and l pan as Left and Right do; L opens the limits.
+    shown(&mut app, "trial", "fb.csv.gz");
+    keys(&mut app, "++l");
+    let panned = app.view.start_s;
+    assert!(panned > 0.0);
+    keys(&mut app, "h");
+    assert!(app.view.start_s < panned);
+    // The trial screen's help is longer than 60x20 shows: it scrolls.
+    keys(&mut app, "?");
+    let first = text(&app, 60, 20);
+    assert!(first.contains("Keys 1-"), "{first}");
+    assert!(!first.contains("mean correction angle"), "{first}");
+    key(&mut app, KeyCode::End);
+    let last = text(&app, 60, 20);
+    assert!(last.contains("mean correction angle"), "{last}");
+    key(&mut app, KeyCode::Up);
+    assert_eq!(app.help_scroll + 1, app.help_max.get());
+    keys(&mut app, "x");
+    assert!(app.overlay.is_none(), "other keys close the help");
+    assert_eq!(app.screen, Screen::Trial);
+    keys(&mut app, "L");
+    assert_eq!(app.screen, Screen::Limits);
 }

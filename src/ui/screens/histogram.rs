@@ -180,8 +180,11 @@ pub fn action(hist: &mut Option<HistogramState>, app: &mut Workbench, a: Action)
     };
     match a {
         Action::Back => return Reply::nav(Nav::To(st.from)),
-        Action::Up => st.joint = st.joint.saturating_sub(1),
-        Action::Down => st.joint = (st.joint + 1).min(st.hists.len().saturating_sub(1)),
+        Action::Up | Action::Down | Action::PageUp | Action::PageDown => {
+            if let Some(i) = crate::ui::cells::list_move(a, st.joint, st.hists.len(), 10) {
+                st.joint = i;
+            }
+        }
         Action::Left if len.is_finite() => {
             span.start_s = (span.start_s - len).max(0.0);
             span.end_s = span.start_s + len;

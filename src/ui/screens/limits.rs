@@ -1,7 +1,7 @@
 //! The limits editor: the joint x axis table and the settings, edited in place.
 
 use crate::limits::HEADER;
-use crate::ui::cells::fit;
+use crate::ui::cells::{counter, fit, list_move};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Effect, Nav, Reply, Screen};
 use crate::ui::theme::Theme;
@@ -41,7 +41,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         ""
     };
     let mut heading = vec![Line::from(vec![
-        Span::raw(format!(" {} ", l.source)),
+        Span::raw(format!(" {} {} ", l.source, counter(l.row, l.rows()))),
         Span::styled(dirty, theme.edited),
     ])];
     if let Some(why) = &l.disk_error {
@@ -216,10 +216,16 @@ pub fn action(app: &mut Workbench, from: Screen, a: Action) -> Reply {
     let n = l.rows();
     match a {
         Action::Back => return Reply::nav(Nav::To(from)),
-        Action::Up => l.row = l.row.saturating_sub(1),
-        Action::Down => l.row = (l.row + 1).min(n.saturating_sub(1)),
-        Action::PageUp => l.row = l.row.saturating_sub(10),
-        Action::PageDown => l.row = (l.row + 10).min(n.saturating_sub(1)),
+        Action::Up
+        | Action::Down
+        | Action::PageUp
+        | Action::PageDown
+        | Action::Home
+        | Action::End => {
+            if let Some(i) = list_move(a, l.row, n, 10) {
+                l.row = i;
+            }
+        }
         Action::Left => l.col = l.col.saturating_sub(1).max(FIRST_EDIT_COL),
         Action::Right => l.col = (l.col + 1).min(LAST_COL),
         Action::Enter => {

@@ -2,7 +2,7 @@
 
 use crate::limits::axis_name;
 use crate::metrics::JointFigures;
-use crate::ui::cells::{fit, num, sel};
+use crate::ui::cells::{counter, fit, list_move, num, sel};
 use crate::ui::glyphs::{sample, Glyphs};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Nav, Reply, Screen, ViewKind};
@@ -71,7 +71,10 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let mut lines = vec![Line::from(Span::styled(
         format!(
             "{}{:>6}{:>6}",
-            fit("joint", iw.saturating_sub(12)),
+            fit(
+                &format!("joint {}", counter(app.joint, joints.len())),
+                iw.saturating_sub(12)
+            ),
             "exc",
             "after"
         ),
@@ -574,8 +577,11 @@ pub fn action(app: &mut Workbench, a: Action) -> Reply {
     let step = (s1 - s0) / 50.0;
     match a {
         Action::Back => return Reply::nav(Nav::To(Screen::Trials)),
-        Action::Up => app.joint = app.joint.saturating_sub(1),
-        Action::Down => app.joint = (app.joint + 1).min(joints.saturating_sub(1)),
+        Action::Up | Action::Down | Action::PageUp | Action::PageDown => {
+            if let Some(i) = list_move(a, app.joint, joints, 10) {
+                app.joint = i;
+            }
+        }
         Action::ZoomIn => zoom(app, true),
         Action::ZoomOut => zoom(app, false),
         Action::Left => app.view.start_s = (s0 - (s1 - s0) / 4.0).max(0.0),

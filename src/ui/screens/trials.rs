@@ -1,7 +1,7 @@
 //! The trials screen: every trial file of the folder, its status and figures.
 
 use crate::acm::Variant;
-use crate::ui::cells::{fit, num, sel};
+use crate::ui::cells::{counter, fit, list_move, num, sel};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Nav, Reply};
 use crate::ui::theme::Theme;
@@ -19,11 +19,11 @@ fn short_name(v: Variant) -> &'static str {
 
 /// The name column's header: the filter first while there is one, so it
 /// stays in view however narrow the column.
-fn name_header(filter: &str, sort: &str) -> String {
+fn name_header(filter: &str, sort: &str, position: &str) -> String {
     if filter.is_empty() {
-        format!("trial (sort: {sort})")
+        format!("trial {position} (sort: {sort})")
     } else {
-        format!("{}  (sort: {sort})", filter.trim_start())
+        format!("{}  {position} (sort: {sort})", filter.trim_start())
     }
 }
 
@@ -53,7 +53,14 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let mut lines = vec![Line::from(Span::styled(
         format!(
             "  {}{:>8}{:>6}{:>5}{}{:>7}{:>7}",
-            fit(&name_header(&filter, app.sort.name()), nw),
+            fit(
+                &name_header(
+                    &filter,
+                    app.sort.name(),
+                    &counter(app.selected, app.visible().len())
+                ),
+                nw
+            ),
             "dur s",
             "Hz",
             "IMUs",
@@ -153,10 +160,16 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
 pub fn action(app: &mut Workbench, a: Action) -> Reply {
     let n = app.visible().len();
     match a {
-        Action::Up => app.selected = app.selected.saturating_sub(1),
-        Action::Down => app.selected = (app.selected + 1).min(n.saturating_sub(1)),
-        Action::PageUp => app.selected = app.selected.saturating_sub(10),
-        Action::PageDown => app.selected = (app.selected + 10).min(n.saturating_sub(1)),
+        Action::Up
+        | Action::Down
+        | Action::PageUp
+        | Action::PageDown
+        | Action::Home
+        | Action::End => {
+            if let Some(i) = list_move(a, app.selected, n, 10) {
+                app.selected = i;
+            }
+        }
         Action::Filter => app.filter_editing = true,
         Action::Back => app.filter.clear(),
         Action::Sort => {
