@@ -176,3 +176,41 @@ pub const FIGURE_LEGEND: &[(&str, &str)] = &[
     ("corr", "mean correction angle, deg"),
     ("exc", "joints: X+Y+Z excursion, deg"),
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The README's keys paragraph names every one-character key the help
+    /// documents (checked against the keymap, so neither drifts).
+    #[test]
+    fn readme_keys_match_the_keymap() {
+        let readme = include_str!("../../README.md");
+        let start = readme
+            .find("\nKeys: ")
+            .expect("the README's keys paragraph");
+        let para = &readme[start..];
+        let para = &para[..para.find("\n\n").unwrap_or(para.len())];
+        let mut missing = vec![];
+        for b in BINDINGS.iter().filter(|b| !b.keys.is_empty()) {
+            for k in b.keys.split([' ', '/']).filter(|k| k.chars().count() == 1) {
+                if !para.contains(&format!("`{k}`")) {
+                    missing.push(format!("{k} ({})", b.help));
+                }
+            }
+        }
+        assert!(missing.is_empty(), "not in the README's keys: {missing:?}");
+    }
+
+    /// Every key resolves to the action of its first binding; the help-only
+    /// rows further down repeat a key with the same action.
+    #[test]
+    fn repeated_keys_keep_their_action() {
+        for (i, b) in BINDINGS.iter().enumerate() {
+            for c in b.code {
+                let first = BINDINGS.iter().position(|x| x.code.contains(c)).unwrap();
+                assert_eq!(BINDINGS[first].action, b.action, "{c:?} in row {i}");
+            }
+        }
+    }
+}

@@ -2,7 +2,7 @@
 //! draws the frame around them (title, status bar) and the overlays.
 
 use super::app::{App, Overlay};
-use super::cells::centred;
+use super::cells::{centred, fit};
 use super::keymap::{help_lines, Scope, FIGURE_LEGEND};
 use super::msg::Screen;
 use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
@@ -61,11 +61,6 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         Screen::Calibration => "Calibration".to_string(),
         Screen::Histogram => "Histograms".to_string(),
     };
-    let mut spans = vec![
-        Span::styled(" acmw ", theme.title),
-        Span::raw(format!("{}  ", app.dir_label)),
-        Span::styled(screen, theme.header),
-    ];
     let right = format!(
         "variant {}{} ",
         app.variant,
@@ -77,8 +72,19 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             ""
         }
     );
+    // The folder and the screen's name give way (cut with `~`) before the
+    // right-hand part runs into them.
+    let w = area.width as usize;
+    let room = w.saturating_sub(6 + right.chars().count() + 2);
+    let dir_w = app.dir_label.chars().count().min(room / 3).max(4).min(room);
+    let screen_w = room.saturating_sub(dir_w + 2);
+    let mut spans = vec![
+        Span::styled(" acmw ", theme.title),
+        Span::raw(format!("{}  ", fit(&app.dir_label, dir_w).trim_end())),
+        Span::styled(fit(&screen, screen_w).trim_end().to_string(), theme.header),
+    ];
     let used: usize = spans.iter().map(|s| s.width()).sum();
-    let pad = (area.width as usize).saturating_sub(used + right.len());
+    let pad = w.saturating_sub(used + right.chars().count());
     spans.push(Span::raw(" ".repeat(pad)));
     spans.push(Span::styled(right, theme.dim));
     f.render_widget(Paragraph::new(Line::from(spans)), area);
@@ -160,6 +166,20 @@ pub fn help_items(screen: Screen, theme: &Theme) -> Vec<Line<'static>> {
                 Span::raw(text),
             ]));
         }
+    }
+    if matches!(screen, Screen::Trials | Screen::Compare) {
+        items.push(Line::from(Span::styled("variant columns", theme.header)));
+        for v in crate::acm::Variant::ALL {
+            let info = v.info();
+            items.push(Line::from(vec![
+                Span::styled(format!(" {:<15}", info.short), theme.title),
+                Span::raw(info.name),
+            ]));
+        }
+        items.push(Line::from(vec![
+            Span::styled(format!(" {:<15}", "exc / variant"), theme.title),
+            Span::raw("mean excursion, deg: before / after"),
+        ]));
     }
     if screen == Screen::Trial {
         items.push(Line::from(Span::styled("figures", theme.header)));

@@ -17,6 +17,19 @@ fn short_name(v: Variant) -> &'static str {
     v.info().short
 }
 
+/// The variant columns' headers, the first marked `<` when columns are
+/// scrolled out of view on the left.
+fn variant_headers(variants: &[Variant], more_left: bool) -> String {
+    let mut h: String = variants
+        .iter()
+        .map(|v| format!("{:>7}", short_name(*v)))
+        .collect();
+    if more_left {
+        h.replace_range(0..1, "<");
+    }
+    h
+}
+
 /// The name column's header: the filter first while there is one, so it
 /// stays in view however narrow the column.
 fn name_header(filter: &str, sort: &str, position: &str) -> String {
@@ -31,14 +44,21 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let details_h = if area.height >= 16 { 5 } else { 0 };
     let [list, details] =
         Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area);
-    // Variant status columns: all that fit beside a 20-character name, at
-    // least the three ACM variants (the baselines show on wider terminals).
+    // Variant status columns: as many as fit beside a 16-character name;
+    // when not all fit they scroll so that the variant shown (`v`) is in
+    // view, `<` and `>` marking columns out of view.
     let base = 2 + 8 + 6 + 5 + 7 + 7;
-    let shown = (3..=Variant::ALL.len())
+    let all = Variant::ALL.len();
+    let shown = (1..=all)
         .rev()
-        .find(|k| list.width as usize >= base + k * 7 + 20)
-        .unwrap_or(3);
-    let variants = &Variant::ALL[..shown];
+        .find(|k| list.width as usize >= base + k * 7 + 16)
+        .unwrap_or(1);
+    let cur = Variant::ALL
+        .iter()
+        .position(|v| *v == app.variant)
+        .unwrap_or(0);
+    let start = cur.saturating_sub(shown - 1).min(all - shown);
+    let variants = &Variant::ALL[start..start + shown];
     let fixed = base + shown * 7;
     let nw = (list.width as usize).saturating_sub(fixed).max(8);
     let filter = if app.filter_editing || !app.filter.is_empty() {
@@ -64,12 +84,13 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
             "dur s",
             "Hz",
             "IMUs",
-            variants
-                .iter()
-                .map(|v| format!("{:>7}", short_name(*v)))
-                .collect::<String>(),
-            "exc",
-            app.variant.name().chars().take(6).collect::<String>(),
+            variant_headers(variants, start > 0),
+            if start + shown < all {
+                ">   exc"
+            } else {
+                "exc"
+            },
+            short_name(app.variant),
         ),
         theme.header,
     ))];
