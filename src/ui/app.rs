@@ -12,7 +12,9 @@ use super::screens::views::ViewsState;
 use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
 use super::workbench::{AngleCache, LimitsState, LoadState, TrialEntry, VariantResult, Workbench};
 use crate::limits::{LimitTable, SettingsFile};
-use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseEventKind};
+use ratatui::crossterm::event::{
+    KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEventKind,
+};
 use std::path::PathBuf;
 
 pub use super::msg::{Effect, Msg, RunJob, Screen};
@@ -49,6 +51,11 @@ pub struct App {
     /// the size last drawn (kept by the drawing).
     pub help_scroll: usize,
     pub help_max: std::cell::Cell<usize>,
+    /// The size of the last frame drawn (where a click landed).
+    pub frame: std::cell::Cell<ratatui::layout::Rect>,
+    /// Mouse capture is on; and the terminal reports the mouse at all.
+    pub mouse: bool,
+    pub mouse_possible: bool,
 }
 
 impl std::ops::Deref for App {
@@ -79,6 +86,9 @@ impl App {
             histogram: None,
             help_scroll: 0,
             help_max: Default::default(),
+            frame: Default::default(),
+            mouse: false,
+            mouse_possible: true,
         }
     }
 }
@@ -103,6 +113,18 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                 match m.kind {
                     MouseEventKind::ScrollUp => return action(app, Action::Up),
                     MouseEventKind::ScrollDown => return action(app, Action::Down),
+                    MouseEventKind::Down(MouseButton::Left)
+                        if app.screen == Screen::Trials && app.overlay.is_none() =>
+                    {
+                        // A click selects the row; on the selected row, opens it.
+                        let body = body_of(app.frame.get());
+                        if let Some(i) = trials::row_at(&app.wb, body, m.row) {
+                            if i == app.selected {
+                                return action(app, Action::Enter);
+                            }
+                            app.selected = i;
+                        }
+                    }
                     _ => {}
                 }
             }
@@ -488,6 +510,20 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
             app.help_scroll = 0;
             return vec![];
         }
+        Action::Mouse => {
+            if !app.mouse_possible {
+                app.error("this terminal (TERM) reports no mouse");
+                return vec![];
+            }
+            app.mouse = !app.mouse;
+            let on = app.mouse;
+            app.info(if on {
+                "mouse on: click selects, the wheel scrolls (M turns it off)"
+            } else {
+                "mouse off: the terminal selects text (M turns it on)"
+            });
+            return vec![Effect::Mouse(app.mouse)];
+        }
         Action::Quit => {
             if app.unsaved() {
                 app.overlay = Some(Overlay::QuitConfirm);
@@ -518,4 +554,13 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Histogram => histogram::action(&mut app.histogram, &mut app.wb, a),
     };
     follow(app, reply)
+}
+
+/// The screens' area of a frame: all but the title and status rows.
+pub fn body_of(frame: ratatui::layout::Rect) -> ratatui::layout::Rect {
+    ratatui::layout::Rect {
+        y: frame.y + 1,
+        height: frame.height.saturating_sub(2),
+        ..frame
+    }
 }

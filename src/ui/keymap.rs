@@ -45,6 +45,7 @@ pub enum Action {
     HeadingDrift,
     Play,
     TimeColour,
+    Mouse,
 }
 
 /// Where a binding applies, for the help overlay.
@@ -125,6 +126,7 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "D", code: &[KeyCode::Char('D')], action: Action::HeadingDrift, scope: Scope::Trial, help: "heading drift per IMU" },
     Binding { keys: "t", code: &[KeyCode::Char('t')], action: Action::TimeColour, scope: Scope::Views, help: "colour by time / limits" },
     Binding { keys: "p", code: &[KeyCode::Char('p')], action: Action::Play, scope: Scope::Views, help: "play / pause (or Space)" },
+    Binding { keys: "M", code: &[KeyCode::Char('M')], action: Action::Mouse, scope: Scope::Everywhere, help: "mouse capture on / off" },
     Binding { keys: "y / n", code: &[KeyCode::Char('y')], action: Action::Yes, scope: Scope::Everywhere, help: "answer a question" },
     Binding { keys: "", code: &[KeyCode::Char('n')], action: Action::No, scope: Scope::Everywhere, help: "" },
     // What keys bound above do on other screens (for their help).

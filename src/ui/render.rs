@@ -15,6 +15,7 @@ use ratatui::Frame;
 /// Draws the whole workbench.
 pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
     let area = f.area();
+    app.frame.set(area);
     if area.width < 20 || area.height < 5 {
         f.render_widget(
             Paragraph::new("acmw: window too small").wrap(Wrap { trim: true }),

@@ -104,11 +104,13 @@ pub fn run(opts: Options) -> anyhow::Result<Option<i32>> {
     let mut app = App::new(label, opts.dir.clone(), files, limits);
     app.model = opts.model.clone().map(Arc::new);
     super::signals::offer_back(&mut app);
+    app.mouse_possible = opts.caps.mouse;
+    app.mouse = opts.caps.mouse && opts.mouse;
     super::signals::install(restore_terminal);
     terminal::enable_raw_mode()?;
     execute!(stdout(), EnterAlternateScreen)?;
     SYNC.store(opts.caps.sync, Ordering::Relaxed);
-    set_mouse(opts.caps.mouse && opts.mouse)?;
+    set_mouse(app.mouse)?;
     let result = event_loop(&mut app, &opts);
     restore_terminal();
     result
@@ -324,6 +326,9 @@ impl Workers {
                 });
             }
             Effect::Debounce => self.debounce = Some(Instant::now() + RECORRECT_DEBOUNCE),
+            Effect::Mouse(on) => {
+                let _ = set_mouse(on);
+            }
             other => {
                 let dir = self.dir.clone();
                 std::thread::spawn(move || {

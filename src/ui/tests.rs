@@ -623,3 +623,42 @@ fn lists_help_and_keys_after_esc() {
     keys(&mut app, "L");
     assert_eq!(app.screen, Screen::Limits);
 }
+
+/// A click selects a trial and a second click opens it; `M` turns mouse
+/// capture off and on (an effect for the runtime).
+#[test]
+fn mouse_clicks_select_and_m_toggles_capture() {
+    use ratatui::crossterm::event::{KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    let _ = draw(&app, &Theme::default(), 80, 24);
+    let click = |row| {
+        Msg::Mouse(MouseEvent {
+            kind: MouseEventKind::Down(MouseButton::Left),
+            column: 10,
+            row,
+            modifiers: KeyModifiers::NONE,
+        })
+    };
+    // Title row, header row, then the trials (broken.csv, fb.csv.gz, knee.csv).
+    SyncRunner::send(&mut app, click(3));
+    assert_eq!(app.selected_entry().unwrap().file, "fb.csv.gz");
+    SyncRunner::send(&mut app, click(20));
+    assert_eq!(
+        app.selected_entry().unwrap().file,
+        "fb.csv.gz",
+        "below the list"
+    );
+    SyncRunner::send(&mut app, click(3));
+    assert_eq!(app.screen, Screen::Trial);
+    assert_eq!(app.open.as_deref(), Some("fb.csv.gz"));
+    assert!(!app.mouse);
+    let fx_m = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('M'))));
+    assert!(app.mouse);
+    assert!(matches!(fx_m[..], [super::msg::Effect::Mouse(true)]));
+    let fx_m = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('M'))));
+    assert!(matches!(fx_m[..], [super::msg::Effect::Mouse(false)]));
+    app.mouse_possible = false;
+    keys(&mut app, "M");
+    assert!(!app.mouse && app.message.as_ref().unwrap().1);
+}

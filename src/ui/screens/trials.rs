@@ -40,18 +40,38 @@ fn name_header(filter: &str, sort: &str, position: &str) -> String {
     }
 }
 
-pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
+/// The list and the details below it.
+fn areas(area: Rect) -> [Rect; 2] {
     let details_h = if area.height >= 16 { 5 } else { 0 };
-    let [list, details] =
-        Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area);
-    // Variant status columns: as many as fit beside a 16-character name;
+    Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area)
+}
+
+/// The first list row shown, for a list `rows` tall.
+fn first_row(app: &Workbench, rows: usize) -> usize {
+    app.selected.saturating_sub(rows.saturating_sub(1))
+}
+
+/// The trial (index into the visible list) drawn at row `y` of the screen,
+/// `body` being the screen's area as last drawn.
+pub fn row_at(app: &Workbench, body: Rect, y: u16) -> Option<usize> {
+    let [list, _] = areas(body);
+    let rows = list.height.saturating_sub(1) as usize;
+    let k = y.checked_sub(list.y + 1)? as usize;
+    let i = first_row(app, rows) + k;
+    (k < rows && i < app.visible().len()).then_some(i)
+}
+
+pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
+    let [list, details] = areas(area);
+    let details_h = details.height;
+    // Variant status columns: as many as fit beside a 20-character name;
     // when not all fit they scroll so that the variant shown (`v`) is in
     // view, `<` and `>` marking columns out of view.
     let base = 2 + 8 + 6 + 5 + 7 + 7;
     let all = Variant::ALL.len();
     let shown = (1..=all)
         .rev()
-        .find(|k| list.width as usize >= base + k * 7 + 16)
+        .find(|k| list.width as usize >= base + k * 7 + 20)
         .unwrap_or(1);
     let cur = Variant::ALL
         .iter()
@@ -96,7 +116,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     ))];
     let visible = app.visible();
     let rows = list.height.saturating_sub(1) as usize;
-    let first = app.selected.saturating_sub(rows.saturating_sub(1));
+    let first = first_row(app, rows);
     for (k, &i) in visible.iter().enumerate().skip(first).take(rows) {
         let e = &app.trials[i];
         let selected = k == app.selected;
