@@ -167,6 +167,118 @@ pub fn help_lines() -> Vec<(&'static str, &'static str, Scope)> {
         .collect()
 }
 
+/// A status-bar hint: the keys as shown, the key the hint's action is
+/// tested with, the action, and what it does on that screen.
+pub struct Hint {
+    pub keys: &'static str,
+    pub key: KeyCode,
+    pub action: Action,
+    pub text: &'static str,
+}
+
+const fn hint(keys: &'static str, key: KeyCode, action: Action, text: &'static str) -> Hint {
+    Hint {
+        keys,
+        key,
+        action,
+        text,
+    }
+}
+
+const TRIALS_HINTS: &[Hint] = &[
+    hint("Enter", KeyCode::Enter, Action::Enter, "open"),
+    hint("r", KeyCode::Char('r'), Action::Run, "run"),
+    hint("/", KeyCode::Char('/'), Action::Filter, "filter"),
+    hint("s", KeyCode::Char('s'), Action::Sort, "sort"),
+    hint("v", KeyCode::Char('v'), Action::Variant, "variant"),
+    hint("L", KeyCode::Char('L'), Action::Limits, "limits"),
+    hint("?", KeyCode::Char('?'), Action::Help, "help"),
+    hint("q", KeyCode::Char('q'), Action::Quit, "quit"),
+];
+
+const TRIAL_HINTS: &[Hint] = &[
+    hint("r", KeyCode::Char('r'), Action::Run, "run"),
+    hint("v", KeyCode::Char('v'), Action::Variant, "variant"),
+    hint("c", KeyCode::Char('c'), Action::Compare, "compare"),
+    hint("+-", KeyCode::Char('+'), Action::ZoomIn, "zoom"),
+    hint("<- ->", KeyCode::Right, Action::Right, "pan"),
+    hint(", .", KeyCode::Char('.'), Action::CursorRight, "cursor"),
+    hint("x o a f D", KeyCode::Char('x'), Action::Scatter, "views"),
+    hint("?", KeyCode::Char('?'), Action::Help, "help"),
+];
+
+const COMPARE_HINTS: &[Hint] = &[
+    hint("<- ->", KeyCode::Left, Action::Left, "variant"),
+    hint("Space", KeyCode::Char(' '), Action::Choose, "choose"),
+    hint("w", KeyCode::Char('w'), Action::Save, "save"),
+    hint("r", KeyCode::Char('r'), Action::Run, "run"),
+    hint("Esc", KeyCode::Esc, Action::Back, "back"),
+    hint("?", KeyCode::Char('?'), Action::Help, "help"),
+];
+
+const LIMITS_HINTS: &[Hint] = &[
+    hint("Enter", KeyCode::Enter, Action::Enter, "edit"),
+    hint("<- ->", KeyCode::Left, Action::Left, "column"),
+    hint("w", KeyCode::Char('w'), Action::Save, "save"),
+    hint("Esc", KeyCode::Esc, Action::Back, "back"),
+    hint("?", KeyCode::Char('?'), Action::Help, "help"),
+    hint("q", KeyCode::Char('q'), Action::Quit, "quit"),
+];
+
+const VIEWS_HINTS: &[Hint] = &[
+    hint("x", KeyCode::Char('x'), Action::Scatter, "scatter"),
+    hint("o", KeyCode::Char('o'), Action::Globe, "globe"),
+    hint("a", KeyCode::Char('a'), Action::Applied, "applied"),
+    hint("f", KeyCode::Char('f'), Action::Stick, "stick"),
+    hint("D", KeyCode::Char('D'), Action::HeadingDrift, "heading"),
+    hint("t", KeyCode::Char('t'), Action::TimeColour, "time"),
+    hint("Esc", KeyCode::Esc, Action::Back, "back"),
+    hint("?", KeyCode::Char('?'), Action::Help, "help"),
+];
+
+const CALIBRATION_HINTS: &[Hint] = &[
+    hint("Up/Down", KeyCode::Down, Action::Down, "recording"),
+    hint("r", KeyCode::Char('r'), Action::Run, "read again"),
+    hint("Esc", KeyCode::Esc, Action::Back, "back"),
+    hint("?", KeyCode::Char('?'), Action::Help, "help"),
+    hint("q", KeyCode::Char('q'), Action::Quit, "quit"),
+];
+
+const HISTOGRAM_HINTS: &[Hint] = &[
+    hint("Enter", KeyCode::Enter, Action::Enter, "suggest"),
+    hint("w", KeyCode::Char('w'), Action::Save, "centroids"),
+    hint("<- ->", KeyCode::Right, Action::Right, "span"),
+    hint("+-", KeyCode::Char('-'), Action::ZoomOut, "length"),
+    hint("Home", KeyCode::Home, Action::Home, "30 s"),
+    hint("End", KeyCode::End, Action::End, "all"),
+    hint("Esc", KeyCode::Esc, Action::Back, "back"),
+    hint("?", KeyCode::Char('?'), Action::Help, "help"),
+];
+
+/// The status-bar hints of the screen whose keys are `scope`'s, most used
+/// first (a narrow terminal shows the first ones). `?` help ends every
+/// screen's hints.
+pub fn hints(scope: Scope) -> &'static [Hint] {
+    match scope {
+        Scope::Trials | Scope::Everywhere => TRIALS_HINTS,
+        Scope::Trial => TRIAL_HINTS,
+        Scope::Compare => COMPARE_HINTS,
+        Scope::Limits => LIMITS_HINTS,
+        Scope::Views => VIEWS_HINTS,
+        Scope::Calibration => CALIBRATION_HINTS,
+        Scope::Histogram => HISTOGRAM_HINTS,
+    }
+}
+
+/// The hints as the status bar shows them.
+pub fn hint_line(scope: Scope) -> String {
+    hints(scope)
+        .iter()
+        .map(|h| format!("{} {}", h.keys, h.text))
+        .collect::<Vec<_>>()
+        .join("  ")
+}
+
 /// What the trial screen's figure columns mean (the help lists them after
 /// the keys): (label, meaning).
 pub const FIGURE_LEGEND: &[(&str, &str)] = &[

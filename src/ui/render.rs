@@ -3,7 +3,7 @@
 
 use super::app::{App, Overlay};
 use super::cells::{centred, fit};
-use super::keymap::{help_lines, Scope, FIGURE_LEGEND};
+use super::keymap::{help_lines, hint_line, Scope, FIGURE_LEGEND};
 use super::msg::Screen;
 use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
 use super::theme::Theme;
@@ -91,31 +91,28 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     f.render_widget(Paragraph::new(Line::from(spans)), area);
 }
 
-/// Key hints of the screen in front.
-pub fn hints(app: &App) -> &'static str {
+/// The keys of each screen, as its help and hints list them.
+pub fn scope_of(screen: Screen) -> Scope {
+    match screen {
+        Screen::Trials => Scope::Trials,
+        Screen::Trial => Scope::Trial,
+        Screen::Compare => Scope::Compare,
+        Screen::Limits => Scope::Limits,
+        Screen::Views => Scope::Views,
+        Screen::Calibration => Scope::Calibration,
+        Screen::Histogram => Scope::Histogram,
+    }
+}
+
+/// Key hints of the screen in front (from the keymap's hints).
+pub fn hints(app: &App) -> String {
     if app.filter_editing {
-        return "type to filter  Enter done  Esc clear";
+        return "type to filter  Enter done  Esc clear".into();
     }
     if app.screen == Screen::Limits && app.limits.edit.is_some() {
-        return "type a value  <- -> Home End move  Enter commit  Esc cancel";
+        return "type a value  <- -> Home End move  Enter commit  Esc cancel".into();
     }
-    match app.screen {
-        Screen::Trials => {
-            "Enter open  r run  / filter  s sort  v variant  L limits  ? help  q quit"
-        }
-        Screen::Trial => {
-            "r run  v variant  c compare  +- zoom  <- -> pan  , . cursor  x o a f D views  ? help"
-        }
-        Screen::Compare => "<- -> variant  Space choose  w save  r run  Esc back  ? help",
-        Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
-        Screen::Views => {
-            "x scatter  o globe  a applied  f stick  D heading  t time  Esc back  ? help"
-        }
-        Screen::Calibration => "Up/Down recording  r read again  Esc back  ? help  q quit",
-        Screen::Histogram => {
-            "Enter suggest  w centroids  <- -> span  +- length  Home 30 s  End all  Esc back"
-        }
-    }
+    hint_line(scope_of(app.screen))
 }
 
 fn status_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
@@ -145,15 +142,7 @@ fn popup(f: &mut Frame, theme: &Theme, area: Rect, title: &str, lines: Vec<Line>
 /// The help's sections for the screen in front: the keys that work
 /// everywhere, the screen's own, and (trial screen) what its figures mean.
 pub fn help_items(screen: Screen, theme: &Theme) -> Vec<Line<'static>> {
-    let own = match screen {
-        Screen::Trials => Scope::Trials,
-        Screen::Trial => Scope::Trial,
-        Screen::Compare => Scope::Compare,
-        Screen::Limits => Scope::Limits,
-        Screen::Views => Scope::Views,
-        Screen::Calibration => Scope::Calibration,
-        Screen::Histogram => Scope::Histogram,
-    };
+    let own = scope_of(screen);
     let mut items: Vec<Line> = vec![];
     for scope in [own, Scope::Everywhere] {
         let entries: Vec<_> = help_lines().into_iter().filter(|l| l.2 == scope).collect();

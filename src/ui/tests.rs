@@ -662,3 +662,103 @@ fn mouse_clicks_select_and_m_toggles_capture() {
     keys(&mut app, "M");
     assert!(!app.mouse && app.message.as_ref().unwrap().1);
 }
+
+/// What a key can change, for telling whether it did anything.
+fn fingerprint(app: &App) -> String {
+    format!(
+        "{:?}",
+        (
+            (
+                app.screen,
+                &app.overlay,
+                app.selected,
+                app.variant,
+                app.joint
+            ),
+            (app.view.zoom, app.view.start_s, app.view.cursor_s),
+            (&app.message, app.filter_editing, app.sort, app.compare_col),
+            (
+                app.limits.edit.is_some(),
+                app.limits.col,
+                app.limits.row,
+                app.quit
+            ),
+            (app.views.kind, app.views.time_colour, app.calib.selected),
+            app.histogram.as_ref().map(|h| {
+                (
+                    h.span,
+                    h.suggestion.is_some(),
+                    h.overwrite.is_some(),
+                    h.joint,
+                )
+            }),
+            app.open_entry().map(|e| e.chosen),
+        )
+    )
+}
+
+/// Every hint in every screen's status bar names a key that has the hint's
+/// action, and pressing it there does something: it changes the state or
+/// asks the runtime for work (from a state where it can: Home after End,
+/// Left after Right, ...). Driven through `update`; nothing sleeps.
+#[test]
+fn every_hint_does_what_it_says() {
+    use super::keymap::{self, hints, Action, BINDINGS};
+    let fx = Fixture::new();
+    let base = fx.app();
+    let key_of = |a: Action| {
+        let b = BINDINGS.iter().find(|b| b.action == a).unwrap();
+        KeyEvent::from(b.code[0])
+    };
+    for (screen, setup) in [
+        ("trials", ""),
+        ("trial", "+"),
+        ("compare", ""),
+        ("limits", ""),
+        ("scatter", ""),
+        ("calibration", ""),
+        ("histogram", ""),
+    ] {
+        let mut app = base.clone();
+        shown(&mut app, screen, "knee.csv");
+        keys(&mut app, setup);
+        app.message = None;
+        let scope = super::render::scope_of(app.screen);
+        let line = super::render::hints(&app);
+        for h in hints(scope) {
+            let what = format!("{screen}: `{}` {}", h.keys, h.text);
+            assert!(line.contains(&format!("{} {}", h.keys, h.text)), "{what}");
+            assert_eq!(
+                keymap::action(&KeyEvent::from(h.key)),
+                Some(h.action),
+                "{what}"
+            );
+            let prep = match h.action {
+                Action::Home => Some(Action::End),
+                Action::End => Some(Action::Home),
+                Action::Left => Some(Action::Right),
+                Action::Right => Some(Action::Left),
+                Action::Down => Some(Action::Up),
+                Action::Up => Some(Action::Down),
+                Action::Scatter => Some(Action::Globe),
+                _ => None,
+            };
+            let acts = |from: &App| {
+                let mut a = from.clone();
+                let before = fingerprint(&a);
+                let effects = update(&mut a, Msg::Key(KeyEvent::from(h.key)));
+                !effects.is_empty() || fingerprint(&a) != before
+            };
+            let mut did = acts(&app);
+            if !did {
+                if let Some(p) = prep {
+                    let mut from = app.clone();
+                    SyncRunner::send(&mut from, Msg::Key(key_of(p)));
+                    from.message = None;
+                    did = acts(&from);
+                }
+            }
+            assert!(did, "{what} did nothing");
+        }
+    }
+}
