@@ -115,6 +115,24 @@ pub fn hints(app: &App) -> String {
     hint_line(scope_of(app.screen))
 }
 
+/// The hints that fit in `w` columns, whole (the first ones: most used),
+/// never one cut in half.
+pub fn fit_hints(line: &str, w: usize) -> String {
+    let mut out = String::new();
+    for h in line.split("  ") {
+        let next = if out.is_empty() {
+            h.to_string()
+        } else {
+            format!("{out}  {h}")
+        };
+        if next.chars().count() > w {
+            break;
+        }
+        out = next;
+    }
+    out
+}
+
 fn status_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
     let line = match &app.message {
         Some((m, true)) => Line::from(vec![
@@ -122,7 +140,10 @@ fn status_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             Span::styled(m.clone(), theme.error),
         ]),
         Some((m, false)) => Line::from(vec![Span::raw(" "), Span::styled(m.clone(), theme.ok)]),
-        None => Line::from(Span::raw(format!(" {}", hints(app)))),
+        None => Line::from(Span::raw(format!(
+            " {}",
+            fit_hints(&hints(app), area.width.saturating_sub(1) as usize)
+        ))),
     };
     f.render_widget(Paragraph::new(line).style(theme.status), area);
 }

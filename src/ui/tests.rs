@@ -762,3 +762,13 @@ fn every_hint_does_what_it_says() {
         }
     }
 }
+
+#[test]
+fn hints_are_dropped_whole_when_narrow() {
+    use super::render::fit_hints;
+    let line = "r run  v variant  ? help";
+    assert_eq!(fit_hints(line, 80), line);
+    assert_eq!(fit_hints(line, 17), "r run  v variant");
+    assert_eq!(fit_hints(line, 16), "r run  v variant");
+    assert_eq!(fit_hints(line, 15), "r run");
+}
