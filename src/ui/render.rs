@@ -116,19 +116,33 @@ pub fn hints(app: &App) -> String {
 }
 
 /// The hints that fit in `w` columns, whole (the first ones: most used),
-/// never one cut in half.
+/// never one cut in half; `? help` stays whatever else goes.
 pub fn fit_hints(line: &str, w: usize) -> String {
+    const HELP: &str = "? help";
+    let keep_help = line.split("  ").any(|h| h == HELP);
+    let room = if keep_help {
+        w.saturating_sub(HELP.len() + 2)
+    } else {
+        w
+    };
     let mut out = String::new();
-    for h in line.split("  ") {
+    for h in line.split("  ").filter(|h| !keep_help || *h != HELP) {
         let next = if out.is_empty() {
             h.to_string()
         } else {
             format!("{out}  {h}")
         };
-        if next.chars().count() > w {
+        if next.chars().count() > room {
             break;
         }
         out = next;
+    }
+    if keep_help && w >= HELP.len() {
+        out = if out.is_empty() {
+            HELP.to_string()
+        } else {
+            format!("{out}  {HELP}")
+        };
     }
     out
 }

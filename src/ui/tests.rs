@@ -766,9 +766,10 @@ fn every_hint_does_what_it_says() {
 #[test]
 fn hints_are_dropped_whole_when_narrow() {
     use super::render::fit_hints;
-    let line = "r run  v variant  ? help";
-    assert_eq!(fit_hints(line, 80), line);
-    assert_eq!(fit_hints(line, 17), "r run  v variant");
-    assert_eq!(fit_hints(line, 16), "r run  v variant");
-    assert_eq!(fit_hints(line, 15), "r run");
+    let line = "r run  v variant  ? help  q quit";
+    assert_eq!(fit_hints(line, 80), "r run  v variant  q quit  ? help");
+    assert_eq!(fit_hints(line, 24), "r run  v variant  ? help");
+    assert_eq!(fit_hints(line, 23), "r run  ? help");
+    assert_eq!(fit_hints(line, 6), "? help");
+    assert_eq!(fit_hints("a b  c d", 5), "a b");
 }
