@@ -72,6 +72,14 @@ pub struct Cli {
     /// Colour theme of the workbench: dark, light or high-contrast (NO_COLOR is honoured).
     #[arg(long, global = true, default_value = "dark")]
     pub theme: String,
+    /// Plain ASCII markers in the charts and views, for fonts without braille
+    /// or block symbols.
+    #[arg(long, global = true)]
+    pub ascii: bool,
+    /// Leave the mouse to the terminal (its own text selection) instead of
+    /// capturing clicks and the wheel.
+    #[arg(long)]
+    pub no_mouse: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -105,12 +113,22 @@ pub fn run(cli: Cli) -> i32 {
         Some(Command::Batch(a)) => batch::run(a),
         Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
-        Some(Command::Render(a)) => render::run(a, &cli.theme),
+        Some(Command::Render(a)) => render::run(a, &cli.theme, cli.ascii),
         Some(Command::SuggestLimits(a)) => analysis::run_suggest(a),
         Some(Command::Centroids(a)) => analysis::run_centroids(a),
         Some(Command::Plot(a)) => plot::run(a),
         Some(Command::Calibrate(a)) => calibrate::run(a),
-        None => workbench(cli.dir, &cli.theme, cli.limits_dir, cli.model, cli.poll),
+        None => workbench(
+            cli.dir,
+            &cli.theme,
+            cli.limits_dir,
+            cli.model,
+            cli.poll,
+            Display {
+                ascii: cli.ascii,
+                mouse: !cli.no_mouse,
+            },
+        ),
     };
     match result {
         Ok(code) => code,
@@ -135,6 +153,14 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
+/// How the workbench draws and listens.
+struct Display {
+    /// `--ascii`.
+    ascii: bool,
+    /// Not `--no-mouse`.
+    mouse: bool,
+}
+
 /// Bare `acmw`: the terminal workbench, when there is a terminal.
 fn workbench(
     dir: Option<PathBuf>,
@@ -142,6 +168,7 @@ fn workbench(
     limits_dir: Option<PathBuf>,
     model: Option<String>,
     poll: Option<f64>,
+    display: Display,
 ) -> anyhow::Result<i32> {
     use std::io::IsTerminal;
     if !(std::io::stdin().is_terminal() && std::io::stdout().is_terminal()) {
@@ -150,9 +177,14 @@ fn workbench(
         );
         return Ok(EXIT_NO_TERMINAL);
     }
-    let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
-    let theme =
-        acm_workbench::ui::theme::Theme::builtin(theme, no_color).map_err(anyhow::Error::msg)?;
+    // TERM decides what the terminal is sent: no colours to a terminal
+    // without them, no mouse or synchronized-output codes where they are
+    // unknown.
+    let caps = acm_workbench::ui::term::Caps::from_env();
+    let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()) || !caps.colour;
+    let theme = acm_workbench::ui::theme::Theme::builtin(theme, no_color)
+        .map_err(anyhow::Error::msg)?
+        .with_ascii(display.ascii);
     let model = model
         .map(|m| acm_workbench::model::Model::load(&m))
         .transpose()?;
@@ -162,6 +194,8 @@ fn workbench(
         model,
         poll: poll.map(std::time::Duration::from_secs_f64),
         theme,
+        caps,
+        mouse: display.mouse,
     })?;
     Ok(signal.map_or(EXIT_OK, acm_workbench::ui::signals::exit_status))
 }

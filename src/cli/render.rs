@@ -51,10 +51,12 @@ pub fn parse_size(s: &str) -> Result<(u16, u16), String> {
     Ok((n(w)?, n(h)?))
 }
 
-pub fn run(a: RenderArgs, theme: &str) -> anyhow::Result<i32> {
+pub fn run(a: RenderArgs, theme: &str, ascii: bool) -> anyhow::Result<i32> {
     let dir = a.dir.unwrap_or_else(|| PathBuf::from("sample_trials"));
     let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
-    let theme = Theme::builtin(theme, no_color).map_err(|e| anyhow!(e))?;
+    let theme = Theme::builtin(theme, no_color)
+        .map_err(|e| anyhow!(e))?
+        .with_ascii(ascii);
     let limits_dir = a
         .limits_dir
         .unwrap_or_else(super::common::default_limits_dir);

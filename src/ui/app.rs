@@ -12,7 +12,9 @@ use super::screens::views::ViewsState;
 use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
 use super::workbench::{AngleCache, LimitsState, LoadState, TrialEntry, VariantResult, Workbench};
 use crate::limits::{LimitTable, SettingsFile};
-use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseEventKind};
+use ratatui::crossterm::event::{
+    KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEventKind,
+};
 use std::path::PathBuf;
 
 pub use super::msg::{Effect, Msg, RunJob, Screen};
@@ -45,6 +47,15 @@ pub struct App {
     pub calib: CalibState,
     /// The histogram screen, once opened.
     pub histogram: Option<HistogramState>,
+    /// First line of the help shown, and the largest that still fills it at
+    /// the size last drawn (kept by the drawing).
+    pub help_scroll: usize,
+    pub help_max: std::cell::Cell<usize>,
+    /// The size of the last frame drawn (where a click landed).
+    pub frame: std::cell::Cell<ratatui::layout::Rect>,
+    /// Mouse capture is on; and the terminal reports the mouse at all.
+    pub mouse: bool,
+    pub mouse_possible: bool,
 }
 
 impl std::ops::Deref for App {
@@ -73,6 +84,11 @@ impl App {
             views: Default::default(),
             calib: Default::default(),
             histogram: None,
+            help_scroll: 0,
+            help_max: Default::default(),
+            frame: Default::default(),
+            mouse: false,
+            mouse_possible: true,
         }
     }
 }
@@ -97,6 +113,18 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                 match m.kind {
                     MouseEventKind::ScrollUp => return action(app, Action::Up),
                     MouseEventKind::ScrollDown => return action(app, Action::Down),
+                    MouseEventKind::Down(MouseButton::Left)
+                        if app.screen == Screen::Trials && app.overlay.is_none() =>
+                    {
+                        // A click selects the row; on the selected row, opens it.
+                        let body = body_of(app.frame.get());
+                        if let Some(i) = trials::row_at(&app.wb, body, m.row) {
+                            if i == app.selected {
+                                return action(app, Action::Enter);
+                            }
+                            app.selected = i;
+                        }
+                    }
                     _ => {}
                 }
             }
@@ -336,6 +364,14 @@ fn recorrect_now(app: &mut App) -> Vec<Effect> {
 }
 
 fn key(app: &mut App, k: KeyEvent) -> Vec<Effect> {
+    // Esc and the next key pressed at once arrive as one Alt-key (the
+    // terminal sends ESC then the key): both are carried out.
+    if k.modifiers.contains(KeyModifiers::ALT) && !k.modifiers.contains(KeyModifiers::CONTROL) {
+        let mut effects = key(app, KeyEvent::from(KeyCode::Esc));
+        let plain = KeyEvent::new(k.code, k.modifiers - KeyModifiers::ALT);
+        effects.extend(key(app, plain));
+        return effects;
+    }
     // Text entry first: the filter and the cell editor take characters
     // (all but Ctrl-C, which quits from anywhere).
     let quit = k.modifiers.contains(KeyModifiers::CONTROL) && k.code == KeyCode::Char('c');
@@ -416,8 +452,24 @@ pub fn wants_ticks(app: &App) -> bool {
 fn action(app: &mut App, a: Action) -> Vec<Effect> {
     // Overlays answer first.
     match (&app.overlay, a) {
-        (Some(Overlay::Help), Action::Quit) => {
-            app.overlay = None;
+        (
+            Some(Overlay::Help),
+            Action::Up
+            | Action::Down
+            | Action::PageUp
+            | Action::PageDown
+            | Action::Home
+            | Action::End,
+        ) => {
+            let (at, max) = (app.help_scroll.min(app.help_max.get()), app.help_max.get());
+            app.help_scroll = match a {
+                Action::Up => at.saturating_sub(1),
+                Action::Down => (at + 1).min(max),
+                Action::PageUp => at.saturating_sub(10),
+                Action::PageDown => (at + 10).min(max),
+                Action::Home => 0,
+                _ => max,
+            };
             return vec![];
         }
         (Some(Overlay::Help), _) => {
@@ -455,7 +507,22 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
     match a {
         Action::Help => {
             app.overlay = Some(Overlay::Help);
+            app.help_scroll = 0;
             return vec![];
+        }
+        Action::Mouse => {
+            if !app.mouse_possible {
+                app.error("this terminal (TERM) reports no mouse");
+                return vec![];
+            }
+            app.mouse = !app.mouse;
+            let on = app.mouse;
+            app.info(if on {
+                "mouse on: click selects, the wheel scrolls (M turns it off)"
+            } else {
+                "mouse off: the terminal selects text (M turns it on)"
+            });
+            return vec![Effect::Mouse(app.mouse)];
         }
         Action::Quit => {
             if app.unsaved() {
@@ -487,4 +554,13 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Histogram => histogram::action(&mut app.histogram, &mut app.wb, a),
     };
     follow(app, reply)
+}
+
+/// The screens' area of a frame: all but the title and status rows.
+pub fn body_of(frame: ratatui::layout::Rect) -> ratatui::layout::Rect {
+    ratatui::layout::Rect {
+        y: frame.y + 1,
+        height: frame.height.saturating_sub(2),
+        ..frame
+    }
 }

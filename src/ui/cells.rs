@@ -1,6 +1,7 @@
 //! Small text and layout helpers the screens share: fixed-width cells, the
 //! selected-row style, a centred popup rectangle.
 
+use super::keymap::Action;
 use super::theme::Theme;
 use ratatui::layout::Rect;
 use ratatui::style::Style;
@@ -45,5 +46,50 @@ pub fn sel(theme: &Theme, selected: bool) -> Style {
         theme.selected
     } else {
         Style::default()
+    }
+}
+
+/// Where a list's selection goes on `a`: Up/Down one row, PgUp/PgDn
+/// `page` rows, Home/End the first and last; None for other actions (and on
+/// an empty list).
+pub fn list_move(a: Action, at: usize, n: usize, page: usize) -> Option<usize> {
+    let last = n.checked_sub(1)?;
+    let page = page.max(1);
+    Some(match a {
+        Action::Up => at.saturating_sub(1),
+        Action::Down => (at + 1).min(last),
+        Action::PageUp => at.saturating_sub(page),
+        Action::PageDown => (at + page).min(last),
+        Action::Home => 0,
+        Action::End => last,
+        _ => return None,
+    })
+}
+
+/// A list's position counter: `73/100` (the selection counted from 1).
+pub fn counter(at: usize, n: usize) -> String {
+    if n == 0 {
+        "0/0".into()
+    } else {
+        format!("{}/{n}", at.min(n - 1) + 1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lists_move_by_row_page_and_end() {
+        assert_eq!(list_move(Action::Down, 98, 100, 10), Some(99));
+        assert_eq!(list_move(Action::Down, 99, 100, 10), Some(99));
+        assert_eq!(list_move(Action::PageDown, 95, 100, 10), Some(99));
+        assert_eq!(list_move(Action::PageUp, 5, 100, 10), Some(0));
+        assert_eq!(list_move(Action::End, 0, 100, 10), Some(99));
+        assert_eq!(list_move(Action::Home, 50, 100, 10), Some(0));
+        assert_eq!(list_move(Action::Enter, 50, 100, 10), None);
+        assert_eq!(list_move(Action::Down, 0, 0, 10), None);
+        assert_eq!(counter(72, 100), "73/100");
+        assert_eq!(counter(0, 0), "0/0");
     }
 }

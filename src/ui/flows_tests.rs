@@ -79,7 +79,7 @@ fn a_broken_limits_file_on_disk_shows_its_located_error_and_keeps_the_table() {
     let fx = Fixture::new();
     let mut app = fx.app();
     // Save the built-in limits so that the folder has them, then break a row.
-    keys(&mut app, "l");
+    keys(&mut app, "L");
     keys(&mut app, "w");
     let dir = app.limits.dir.clone();
     let name = app.limits.table_name.clone();

@@ -109,7 +109,7 @@ mod tests {
             t.draw(|f| render(&app, &Theme::default(), f)).unwrap();
             let text = format!("{:?}", t.backend());
             assert!(text.contains("glitch 1/1 (G next)"), "{text}");
-            assert!(text.contains('█'), "no glitch marker at {w}x{h}");
+            assert!(text.contains('×'), "no glitch marker at {w}x{h}");
             insta::assert_snapshot!(format!("trial_glitch_{w}x{h}"), t.backend());
         }
     }

@@ -13,7 +13,6 @@ use crate::acm::Variant;
 use crate::model::Model;
 use ratatui::backend::TestBackend;
 use ratatui::buffer::{Buffer, CellWidth};
-use ratatui::style::{Color, Modifier};
 use ratatui::Terminal;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -174,32 +173,6 @@ pub fn buffer_text(buf: &Buffer) -> String {
     out
 }
 
-fn sgr_colour(c: Color, fg: bool) -> Option<String> {
-    let base = if fg { 30 } else { 40 };
-    let n = match c {
-        Color::Reset => return None,
-        Color::Black => base,
-        Color::Red => base + 1,
-        Color::Green => base + 2,
-        Color::Yellow => base + 3,
-        Color::Blue => base + 4,
-        Color::Magenta => base + 5,
-        Color::Cyan => base + 6,
-        Color::Gray => base + 7,
-        Color::DarkGray => base + 60,
-        Color::LightRed => base + 61,
-        Color::LightGreen => base + 62,
-        Color::LightYellow => base + 63,
-        Color::LightBlue => base + 64,
-        Color::LightMagenta => base + 65,
-        Color::LightCyan => base + 66,
-        Color::White => base + 67,
-        Color::Indexed(i) => return Some(format!("{};5;{i}", base + 8)),
-        Color::Rgb(r, g, b) => return Some(format!("{};2;{r};{g};{b}", base + 8)),
-    };
-    Some(n.to_string())
-}
-
 /// The buffer with ANSI SGR codes wherever the style changes.
 pub fn buffer_ansi(buf: &Buffer) -> String {
     let mut out = String::new();
@@ -211,22 +184,7 @@ pub fn buffer_ansi(buf: &Buffer) -> String {
         let mut last: Option<String> = None;
         let mut skip = 0u16;
         for c in row {
-            let mut codes = vec!["0".to_string()];
-            let m = c.modifier;
-            for (flag, code) in [
-                (Modifier::BOLD, "1"),
-                (Modifier::DIM, "2"),
-                (Modifier::ITALIC, "3"),
-                (Modifier::UNDERLINED, "4"),
-                (Modifier::REVERSED, "7"),
-            ] {
-                if m.contains(flag) {
-                    codes.push(code.into());
-                }
-            }
-            codes.extend(sgr_colour(c.fg, true));
-            codes.extend(sgr_colour(c.bg, false));
-            let sgr = format!("\x1b[{}m", codes.join(";"));
+            let sgr = super::term::sgr(c.fg, c.bg, c.modifier);
             if last.as_deref() != Some(sgr.as_str()) {
                 out.push_str(&sgr);
                 last = Some(sgr);

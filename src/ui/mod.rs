@@ -14,6 +14,7 @@
 pub mod app;
 pub mod cells;
 pub mod glitches;
+pub mod glyphs;
 pub mod headless;
 pub mod jobs;
 pub mod keymap;
@@ -24,6 +25,7 @@ pub mod render;
 pub mod runtime;
 pub mod screens;
 pub mod signals;
+pub mod term;
 pub mod theme;
 pub mod workbench;
 

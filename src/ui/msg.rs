@@ -78,6 +78,8 @@ pub enum Effect {
     /// Ask for `Msg::RecorrectDue` after the debounce delay (a newer request
     /// replaces an older one).
     Debounce,
+    /// Turn mouse capture on or off (`M`).
+    Mouse(bool),
     /// Pose-calibrate a loaded trial (answered by `Msg::PoseCalibrated`).
     PoseCalibrate {
         file: String,

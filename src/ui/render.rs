@@ -2,8 +2,8 @@
 //! draws the frame around them (title, status bar) and the overlays.
 
 use super::app::{App, Overlay};
-use super::cells::centred;
-use super::keymap::{help_lines, Scope};
+use super::cells::{centred, fit};
+use super::keymap::{help_lines, hint_line, Scope, FIGURE_LEGEND};
 use super::msg::Screen;
 use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
 use super::theme::Theme;
@@ -15,6 +15,7 @@ use ratatui::Frame;
 /// Draws the whole workbench.
 pub fn render(app: &App, theme: &Theme, f: &mut Frame) {
     let area = f.area();
+    app.frame.set(area);
     if area.width < 20 || area.height < 5 {
         f.render_widget(
             Paragraph::new("acmw: window too small").wrap(Wrap { trim: true }),
@@ -61,11 +62,6 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
         Screen::Calibration => "Calibration".to_string(),
         Screen::Histogram => "Histograms".to_string(),
     };
-    let mut spans = vec![
-        Span::styled(" acmw ", theme.title),
-        Span::raw(format!("{}  ", app.dir_label)),
-        Span::styled(screen, theme.header),
-    ];
     let right = format!(
         "variant {}{} ",
         app.variant,
@@ -77,38 +73,78 @@ fn title_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             ""
         }
     );
+    // The folder and the screen's name give way (cut with `~`) before the
+    // right-hand part runs into them.
+    let w = area.width as usize;
+    let room = w.saturating_sub(6 + right.chars().count() + 2);
+    let dir_w = app.dir_label.chars().count().min(room / 3).max(4).min(room);
+    let screen_w = room.saturating_sub(dir_w + 2);
+    let mut spans = vec![
+        Span::styled(" acmw ", theme.title),
+        Span::raw(format!("{}  ", fit(&app.dir_label, dir_w).trim_end())),
+        Span::styled(fit(&screen, screen_w).trim_end().to_string(), theme.header),
+    ];
     let used: usize = spans.iter().map(|s| s.width()).sum();
-    let pad = (area.width as usize).saturating_sub(used + right.len());
+    let pad = w.saturating_sub(used + right.chars().count());
     spans.push(Span::raw(" ".repeat(pad)));
     spans.push(Span::styled(right, theme.dim));
     f.render_widget(Paragraph::new(Line::from(spans)), area);
 }
 
-/// Key hints of the screen in front.
-pub fn hints(app: &App) -> &'static str {
+/// The keys of each screen, as its help and hints list them.
+pub fn scope_of(screen: Screen) -> Scope {
+    match screen {
+        Screen::Trials => Scope::Trials,
+        Screen::Trial => Scope::Trial,
+        Screen::Compare => Scope::Compare,
+        Screen::Limits => Scope::Limits,
+        Screen::Views => Scope::Views,
+        Screen::Calibration => Scope::Calibration,
+        Screen::Histogram => Scope::Histogram,
+    }
+}
+
+/// Key hints of the screen in front (from the keymap's hints).
+pub fn hints(app: &App) -> String {
     if app.filter_editing {
-        return "type to filter  Enter done  Esc clear";
+        return "type to filter  Enter done  Esc clear".into();
     }
     if app.screen == Screen::Limits && app.limits.edit.is_some() {
-        return "type a value  <- -> Home End move  Enter commit  Esc cancel";
+        return "type a value  <- -> Home End move  Enter commit  Esc cancel".into();
     }
-    match app.screen {
-        Screen::Trials => {
-            "Enter open  r run  / filter  s sort  v variant  l limits  ? help  q quit"
+    hint_line(scope_of(app.screen))
+}
+
+/// The hints that fit in `w` columns, whole (the first ones: most used),
+/// never one cut in half; `? help` stays whatever else goes.
+pub fn fit_hints(line: &str, w: usize) -> String {
+    const HELP: &str = "? help";
+    let keep_help = line.split("  ").any(|h| h == HELP);
+    let room = if keep_help {
+        w.saturating_sub(HELP.len() + 2)
+    } else {
+        w
+    };
+    let mut out = String::new();
+    for h in line.split("  ").filter(|h| !keep_help || *h != HELP) {
+        let next = if out.is_empty() {
+            h.to_string()
+        } else {
+            format!("{out}  {h}")
+        };
+        if next.chars().count() > room {
+            break;
         }
-        Screen::Trial => {
-            "r run  v variant  c compare  +- zoom  <- -> pan  , . cursor  x o a f D views  ? help"
-        }
-        Screen::Compare => "<- -> variant  Space choose  w save  r run  Esc back  ? help",
-        Screen::Limits => "Enter edit  <- -> column  w save  Esc back  ? help  q quit",
-        Screen::Views => {
-            "x scatter  o globe  a applied  f stick  D heading  t time  Esc back  ? help"
-        }
-        Screen::Calibration => "Up/Down recording  r read again  Esc back  ? help  q quit",
-        Screen::Histogram => {
-            "Enter suggest  w centroids  <- -> span  +- length  Home 30 s  End all  Esc back"
-        }
+        out = next;
     }
+    if keep_help && w >= HELP.len() {
+        out = if out.is_empty() {
+            HELP.to_string()
+        } else {
+            format!("{out}  {HELP}")
+        };
+    }
+    out
 }
 
 fn status_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
@@ -118,7 +154,10 @@ fn status_bar(app: &App, theme: &Theme, f: &mut Frame, area: Rect) {
             Span::styled(m.clone(), theme.error),
         ]),
         Some((m, false)) => Line::from(vec![Span::raw(" "), Span::styled(m.clone(), theme.ok)]),
-        None => Line::from(Span::raw(format!(" {}", hints(app)))),
+        None => Line::from(Span::raw(format!(
+            " {}",
+            fit_hints(&hints(app), area.width.saturating_sub(1) as usize)
+        ))),
     };
     f.render_widget(Paragraph::new(line).style(theme.status), area);
 }
@@ -135,63 +174,76 @@ fn popup(f: &mut Frame, theme: &Theme, area: Rect, title: &str, lines: Vec<Line>
     );
 }
 
-fn help(_app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
-    let order = [
-        Scope::Everywhere,
-        Scope::Trials,
-        Scope::Trial,
-        Scope::Compare,
-        Scope::Limits,
-        Scope::Views,
-    ];
+/// The help's sections for the screen in front: the keys that work
+/// everywhere, the screen's own, and (trial screen) what its figures mean.
+pub fn help_items(screen: Screen, theme: &Theme) -> Vec<Line<'static>> {
+    let own = scope_of(screen);
     let mut items: Vec<Line> = vec![];
-    let mut headings = vec![];
-    for scope in order {
+    for scope in [own, Scope::Everywhere] {
         let entries: Vec<_> = help_lines().into_iter().filter(|l| l.2 == scope).collect();
         if entries.is_empty() {
             continue;
         }
-        headings.push(items.len());
         items.push(Line::from(Span::styled(scope.title(), theme.header)));
         for (keys, text, _) in entries {
             items.push(Line::from(vec![
-                Span::styled(format!(" {keys:<11}"), theme.title),
+                Span::styled(format!(" {keys:<15}"), theme.title),
                 Span::raw(text),
             ]));
         }
     }
-    // Two columns when the list is taller than the screen.
-    let inner_h = body.height.saturating_sub(3) as usize;
-    let two = items.len() > inner_h && body.width >= 78;
-    // A heading never ends the left column: it moves to the right one.
-    if two {
-        let half = items.len().div_ceil(2);
-        if headings.contains(&(half - 1)) {
-            items.insert(half - 1, Line::default());
+    if matches!(screen, Screen::Trials | Screen::Compare) {
+        items.push(Line::from(Span::styled("variant columns", theme.header)));
+        for v in crate::acm::Variant::ALL {
+            let info = v.info();
+            items.push(Line::from(vec![
+                Span::styled(format!(" {:<15}", info.short), theme.title),
+                Span::raw(info.name),
+            ]));
+        }
+        items.push(Line::from(vec![
+            Span::styled(format!(" {:<15}", "exc / variant"), theme.title),
+            Span::raw("mean excursion, deg: before / after"),
+        ]));
+    }
+    if screen == Screen::Trial {
+        items.push(Line::from(Span::styled("figures", theme.header)));
+        for (label, text) in FIGURE_LEGEND {
+            items.push(Line::from(vec![
+                Span::styled(format!(" {label:<15}"), theme.title),
+                Span::raw(*text),
+            ]));
         }
     }
-    let w = if two { 78 } else { 50 };
-    let rows = if two {
-        items.len().div_ceil(2)
+    items
+}
+
+fn help(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
+    let items = help_items(app.screen, theme);
+    let n = items.len();
+    let area = centred(body, 62, n as u16 + 2);
+    let inner_h = area.height.saturating_sub(2) as usize;
+    let max = n.saturating_sub(inner_h);
+    app.help_max.set(max);
+    let first = app.help_scroll.min(max);
+    let title = if max == 0 {
+        " Keys (any key closes) ".to_string()
     } else {
-        items.len()
+        format!(
+            " Keys {}-{} of {n} (Up/Down PgUp/PgDn scroll, other keys close) ",
+            first + 1,
+            (first + inner_h).min(n)
+        )
     };
-    let area = centred(body, w, rows as u16 + 2);
     f.render_widget(Clear, area);
-    let block = Block::new()
-        .borders(Borders::ALL)
-        .title(Span::styled(" Keys (any key closes) ", theme.title));
-    let inner = block.inner(area);
-    f.render_widget(block, area);
-    if two {
-        let half = items.len().div_ceil(2);
-        let right = items.split_off(half);
-        let [a, b] = Layout::horizontal([Constraint::Ratio(1, 2); 2]).areas(inner);
-        f.render_widget(Paragraph::new(items), a);
-        f.render_widget(Paragraph::new(right), b);
-    } else {
-        f.render_widget(Paragraph::new(items), inner);
-    }
+    f.render_widget(
+        Paragraph::new(items.into_iter().skip(first).collect::<Vec<_>>()).block(
+            Block::new()
+                .borders(Borders::ALL)
+                .title(Span::styled(title, theme.title)),
+        ),
+        area,
+    );
 }
 
 fn quit_confirm(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {

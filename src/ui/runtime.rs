@@ -7,6 +7,7 @@
 use super::app::{update, App, Effect, Msg};
 use super::jobs::{self, list_trials, load_limits, read_limits_on_disk};
 use super::render::render;
+use super::term::{BasicColours, Caps};
 use super::theme::Theme;
 use crate::trial::{is_trial_file, is_trial_path};
 
@@ -17,7 +18,6 @@ fn is_xml(p: &Path) -> bool {
 use crossbeam_channel::{unbounded, Receiver, Sender};
 use notify::RecursiveMode;
 use notify_debouncer_full::{new_debouncer, new_debouncer_opt, DebounceEventResult};
-use ratatui::backend::CrosstermBackend;
 use ratatui::crossterm::event::{self, DisableMouseCapture, EnableMouseCapture, Event as CtEvent};
 use ratatui::crossterm::terminal::{
     self, BeginSynchronizedUpdate, EndSynchronizedUpdate, EnterAlternateScreen,
@@ -43,18 +43,36 @@ enum Event {
     Signal(i32),
 }
 
-/// Leaves raw mode, the alternate screen and mouse capture.
+/// Whether mouse capture is on (so that leaving turns it off).
+static MOUSE_ON: AtomicBool = AtomicBool::new(false);
+/// Whether the terminal takes synchronized output.
+static SYNC: AtomicBool = AtomicBool::new(false);
+
+/// Leaves raw mode, the alternate screen and mouse capture (the codes of
+/// what was turned on only).
 pub fn restore_terminal() {
     let mut out = stdout();
-    let _ = execute!(
-        out,
-        EndSynchronizedUpdate,
-        DisableMouseCapture,
-        LeaveAlternateScreen,
-        cursor::Show
-    );
+    if SYNC.load(Ordering::Relaxed) {
+        let _ = execute!(out, EndSynchronizedUpdate);
+    }
+    if MOUSE_ON.swap(false, Ordering::Relaxed) {
+        let _ = execute!(out, DisableMouseCapture);
+    }
+    let _ = execute!(out, LeaveAlternateScreen, cursor::Show);
     let _ = terminal::disable_raw_mode();
     let _ = out.flush();
+}
+
+/// Turns mouse capture on or off.
+pub fn set_mouse(on: bool) -> std::io::Result<()> {
+    if MOUSE_ON.swap(on, Ordering::Relaxed) != on {
+        if on {
+            execute!(stdout(), EnableMouseCapture)?;
+        } else {
+            execute!(stdout(), DisableMouseCapture)?;
+        }
+    }
+    Ok(())
 }
 
 /// Where the workbench looks.
@@ -69,6 +87,11 @@ pub struct Options {
     /// the system's change notifications (network file systems).
     pub poll: Option<Duration>,
     pub theme: Theme,
+    /// What the terminal can do (mouse reports, synchronized output).
+    pub caps: Caps,
+    /// Capture the mouse (where the terminal reports it); off leaves the
+    /// terminal's own text selection alone.
+    pub mouse: bool,
 }
 
 /// Runs the workbench until the user quits or a signal ends it; returns the
@@ -81,9 +104,13 @@ pub fn run(opts: Options) -> anyhow::Result<Option<i32>> {
     let mut app = App::new(label, opts.dir.clone(), files, limits);
     app.model = opts.model.clone().map(Arc::new);
     super::signals::offer_back(&mut app);
+    app.mouse_possible = opts.caps.mouse;
+    app.mouse = opts.caps.mouse && opts.mouse;
     super::signals::install(restore_terminal);
     terminal::enable_raw_mode()?;
-    execute!(stdout(), EnterAlternateScreen, EnableMouseCapture)?;
+    execute!(stdout(), EnterAlternateScreen)?;
+    SYNC.store(opts.caps.sync, Ordering::Relaxed);
+    set_mouse(app.mouse)?;
     let result = event_loop(&mut app, &opts);
     restore_terminal();
     result
@@ -299,6 +326,9 @@ impl Workers {
                 });
             }
             Effect::Debounce => self.debounce = Some(Instant::now() + RECORRECT_DEBOUNCE),
+            Effect::Mouse(on) => {
+                let _ = set_mouse(on);
+            }
             other => {
                 let dir = self.dir.clone();
                 std::thread::spawn(move || {
@@ -312,18 +342,24 @@ impl Workers {
 }
 
 fn draw(
-    terminal: &mut Terminal<CrosstermBackend<std::io::Stdout>>,
+    terminal: &mut Terminal<BasicColours<std::io::Stdout>>,
     app: &App,
     theme: &Theme,
 ) -> std::io::Result<()> {
-    execute!(stdout(), BeginSynchronizedUpdate)?;
+    let sync = SYNC.load(Ordering::Relaxed);
+    if sync {
+        execute!(stdout(), BeginSynchronizedUpdate)?;
+    }
     terminal.draw(|f| render(app, theme, f))?;
-    execute!(stdout(), EndSynchronizedUpdate)
+    if sync {
+        execute!(stdout(), EndSynchronizedUpdate)?;
+    }
+    Ok(())
 }
 
 fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<Option<i32>> {
     let (tx, rx): (Sender<Event>, Receiver<Event>) = unbounded();
-    let mut terminal = Terminal::new(CrosstermBackend::new(stdout()))?;
+    let mut terminal = Terminal::new(BasicColours::new(stdout()))?;
     terminal.clear()?;
     draw(&mut terminal, app, &opts.theme)?;
     spawn_input(tx.clone());

@@ -3,7 +3,7 @@
 //! [`SyncRunner`]; nothing sleeps.
 
 use super::app::{update, App, Msg, Overlay};
-use super::headless::{draw, load_app, show, write_demo_folder, Show, SCREENS};
+use super::headless::{buffer_ansi, draw, load_app, show, write_demo_folder, Show, SCREENS};
 use super::jobs::SyncRunner;
 use super::msg::Screen;
 use super::render::render;
@@ -15,7 +15,7 @@ use ratatui::Terminal;
 use std::path::Path;
 
 /// Sizes every screen is checked at.
-pub const SIZES: [(u16, u16); 2] = [(80, 24), (120, 40)];
+pub const SIZES: [(u16, u16); 3] = [(60, 20), (80, 24), (120, 40)];
 
 pub(super) struct Fixture {
     tmp: tempfile::TempDir,
@@ -65,6 +65,19 @@ pub(super) fn snap(name: &str, app: &App) {
     }
 }
 
+/// Style snapshots (ANSI SGR per cell): under `NO_COLOR` at every size,
+/// where only glyphs and modifiers tell things apart, and in colour at
+/// 80x24.
+pub(super) fn snap_styled(name: &str, app: &App) {
+    let plain = Theme::builtin("dark", true).unwrap();
+    for (w, h) in SIZES {
+        let text = buffer_ansi(&draw(app, &plain, w, h));
+        insta::assert_snapshot!(format!("{name}_nocolor_{w}x{h}"), text);
+    }
+    let text = buffer_ansi(&draw(app, &Theme::default(), 80, 24));
+    insta::assert_snapshot!(format!("{name}_colour_80x24"), text);
+}
+
 fn shown(app: &mut App, screen: &str, trial: &str) {
     show(
         app,
@@ -85,6 +98,7 @@ fn screens() {
         let mut app = fx.app();
         shown(&mut app, screen, "knee.csv");
         snap(screen, &app);
+        snap_styled(screen, &app);
     }
 }
 
@@ -269,7 +283,7 @@ fn compare_scrolls_to_the_baselines_and_saves_one() {
 fn limits_app(fx: &Fixture) -> App {
     let mut app = fx.app();
     shown(&mut app, "trial", "knee.csv");
-    keys(&mut app, "l");
+    keys(&mut app, "L");
     assert_eq!(app.screen, Screen::Limits);
     // knee, Y, upper.
     app.limits.row = app
@@ -392,4 +406,370 @@ fn tiny_sizes_never_panic() {
             let _ = draw(&app, &Theme::default(), w, h);
         }
     }
+}
+
+/// Under `NO_COLOR` the trial screen still tells raw, corrected and the
+/// limits apart (by glyph, named in the legend), its three charts share one
+/// plot column, and the y ticks are round values in degrees.
+#[test]
+fn trial_charts_read_without_colour() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    shown(&mut app, "trial", "knee.csv");
+    let plain = Theme::builtin("dark", true).unwrap();
+    let is_braille = |c: char| ('\u{2801}'..='\u{28ff}').contains(&c);
+    for (w, h) in SIZES {
+        let buf = draw(&app, &plain, w, h);
+        assert!(buf
+            .content
+            .iter()
+            .all(|c| c.fg == ratatui::style::Color::Reset && c.bg == ratatui::style::Color::Reset));
+        let text = super::headless::buffer_text(&buf);
+        // The legend, shortened where the full one does not fit.
+        let items = if w >= 80 {
+            ["⠒⠒ raw", "▄▀ drift", "══ limits", "┊ cursor"]
+        } else {
+            ["⠒raw", "▄drift", "═lim", "┊cur"]
+        };
+        let legend = text.lines().find(|l| l.contains(items[0])).expect("legend");
+        for item in items {
+            assert!(legend.contains(item), "{w}x{h}: {legend}");
+        }
+        let plot: String = text.lines().filter(|l| l.contains("°│")).collect();
+        assert!(plot.chars().any(is_braille), "raw in braille");
+        assert!(
+            plot.contains('▄') || plot.contains('▀'),
+            "corrected in half blocks"
+        );
+        assert!(plot.contains('═'), "limit lines");
+        // Every tick ends its label at the same column, a multiple of 10 deg
+        // here (the knee's angles span tens of degrees).
+        let mut columns = std::collections::BTreeSet::new();
+        let mut ticks = 0;
+        for line in text.lines() {
+            let chars: Vec<char> = line.chars().collect();
+            if let Some(k) = chars.windows(2).position(|p| p == ['°', '│']) {
+                columns.insert(k);
+                let start = chars[..k]
+                    .iter()
+                    .rposition(|c| *c == ' ' || *c == '│')
+                    .unwrap()
+                    + 1;
+                let v: f64 = chars[start..k].iter().collect::<String>().parse().unwrap();
+                assert_eq!(v % 10.0, 0.0, "{line}");
+                ticks += 1;
+            }
+        }
+        assert_eq!(columns.len(), 1, "{w}x{h}: plot areas aligned\n{text}");
+        assert!(ticks >= 3, "{w}x{h}: {ticks} ticks");
+        assert!(text.contains("at cursor raw"), "cursor values labelled");
+    }
+    // ASCII: nothing but ASCII in the plots and the legend.
+    let ascii = Theme::default().with_ascii(true);
+    let text = super::headless::buffer_text(&draw(&app, &ascii, 80, 24));
+    assert!(
+        !text
+            .chars()
+            .any(|c| is_braille(c) || "▄▀█•═┄┊×".contains(c)),
+        "{text}"
+    );
+    assert!(text.contains(".. raw  ** drift  == limits"), "{text}");
+}
+
+#[test]
+fn ticks_are_round_and_few() {
+    use super::screens::trial::ticks;
+    assert_eq!(ticks(-7.2, 136.4, 5), (50.0, vec![0.0, 50.0, 100.0]));
+    assert_eq!(
+        ticks(-7.2, 136.4, 8).1,
+        vec![0.0, 20.0, 40.0, 60.0, 80.0, 100.0, 120.0]
+    );
+    let (step, v) = ticks(-0.8, 0.9, 4);
+    assert_eq!(step, 0.5);
+    assert_eq!(v, vec![-0.5, 0.0, 0.5]);
+    assert!(ticks(f64::NAN, 1.0, 3).1.is_empty());
+    assert_eq!(ticks(3.0, 3.5, 1).1, vec![3.0]);
+}
+
+/// Clears the cell being edited and types `text`.
+fn retype(app: &mut App, text: &str) {
+    use ratatui::crossterm::event::KeyModifiers;
+    let ctrl_u = KeyEvent::new(KeyCode::Char('u'), KeyModifiers::CONTROL);
+    SyncRunner::send(app, Msg::Key(ctrl_u));
+    keys(app, text);
+}
+
+fn edit_error(app: &App) -> Option<String> {
+    app.limits.edit.as_ref().and_then(|e| e.error.clone())
+}
+
+#[test]
+fn limits_editor_keeps_centroids_inside_and_lambda2_in_range() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    keys(&mut app, "L");
+    assert_eq!(app.screen, Screen::Limits);
+    let row = |app: &App, joint: &str, axis: usize| {
+        app.limits
+            .table
+            .rows
+            .iter()
+            .position(|r| r.joint == joint && r.axis == axis)
+            .unwrap()
+    };
+    // Hip Y: -30..100, centroid 12 (Table 3-2, Table 3-3).
+    app.limits.row = row(&app, "hip", 1);
+    app.limits.col = 5;
+    key(&mut app, KeyCode::Enter);
+    retype(&mut app, "110");
+    let e = edit_error(&app).expect("rejected");
+    assert!(
+        e.contains("centroid 110 must lie within the limits [-30, 100]"),
+        "{e}"
+    );
+    key(&mut app, KeyCode::Enter);
+    assert!(app.limits.edit.is_some(), "not committed");
+    key(&mut app, KeyCode::Esc);
+    // Limits moved past the centroid: the same rule.
+    app.limits.col = 4;
+    key(&mut app, KeyCode::Enter);
+    retype(&mut app, "10");
+    let e = edit_error(&app).expect("rejected");
+    assert!(
+        e.contains("centroid 12 must lie within the limits [-30, 10]"),
+        "{e}"
+    );
+    key(&mut app, KeyCode::Esc);
+    // lambda2: a stated range, and the joint's three rows, said before and after.
+    app.limits.col = 6;
+    let text = super::headless::buffer_text(&draw(&app, &Theme::default(), 120, 40));
+    assert!(text.contains("applies to hip's three rows"), "{text}");
+    key(&mut app, KeyCode::Enter);
+    retype(&mut app, "1e9");
+    let e = edit_error(&app).expect("rejected");
+    assert!(e.contains("within 0..1000"), "{e}");
+    retype(&mut app, "40");
+    assert_eq!(edit_error(&app), None);
+    key(&mut app, KeyCode::Enter);
+    let hips: Vec<f64> = app
+        .limits
+        .table
+        .rows
+        .iter()
+        .filter(|r| r.joint == "hip")
+        .map(|r| r.lambda2)
+        .collect();
+    assert_eq!(hips, [40.0; 3]);
+    let (m, _) = app.message.clone().unwrap();
+    assert!(
+        m.contains("lambda2 of hip set to 40 on its three rows"),
+        "{m}"
+    );
+    // Only where a centroid is set: the knee has none.
+    app.limits.row = row(&app, "knee", 1);
+    key(&mut app, KeyCode::Enter);
+    retype(&mut app, "30");
+    let e = edit_error(&app).expect("rejected");
+    assert!(e.contains("knee has none"), "{e}");
+    retype(&mut app, "0");
+    assert_eq!(edit_error(&app), None);
+    key(&mut app, KeyCode::Esc);
+}
+
+/// Keys that move through lists and the help: Home/End and a counter on
+/// the trials list, h/l as Left/Right, Esc pressed together with the next
+/// key (an Alt-key) carried out as both, and the help scrolling at 60x20.
+#[test]
+fn lists_help_and_keys_after_esc() {
+    use ratatui::crossterm::event::KeyModifiers;
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    let text = |app: &App, w, h| super::headless::buffer_text(&draw(app, &Theme::default(), w, h));
+    assert!(text(&app, 80, 24).contains("trial 1/3 (sort: name)"));
+    key(&mut app, KeyCode::End);
+    assert_eq!(app.selected, 2);
+    assert!(text(&app, 80, 24).contains("trial 3/3 (sort: name)"));
+    key(&mut app, KeyCode::Home);
+    assert_eq!(app.selected, 0);
+    // Esc and `s` at once: the filter ends, then the list is sorted.
+    keys(&mut app, "/kn");
+    assert!(app.filter_editing);
+    SyncRunner::send(
+        &mut app,
+        Msg::Key(KeyEvent::new(KeyCode::Char('s'), KeyModifiers::ALT)),
+    );
+    assert!(!app.filter_editing);
+    assert_eq!(app.sort, super::app::SortKey::Duration);
+    // h and l pan as Left and Right do; L opens the limits.
+    shown(&mut app, "trial", "fb.csv.gz");
+    keys(&mut app, "++l");
+    let panned = app.view.start_s;
+    assert!(panned > 0.0);
+    keys(&mut app, "h");
+    assert!(app.view.start_s < panned);
+    // The trial screen's help is longer than 60x20 shows: it scrolls.
+    keys(&mut app, "?");
+    let first = text(&app, 60, 20);
+    assert!(first.contains("Keys 1-"), "{first}");
+    assert!(!first.contains("mean correction angle"), "{first}");
+    key(&mut app, KeyCode::End);
+    let last = text(&app, 60, 20);
+    assert!(last.contains("mean correction angle"), "{last}");
+    key(&mut app, KeyCode::Up);
+    assert_eq!(app.help_scroll + 1, app.help_max.get());
+    keys(&mut app, "x");
+    assert!(app.overlay.is_none(), "other keys close the help");
+    assert_eq!(app.screen, Screen::Trial);
+    keys(&mut app, "L");
+    assert_eq!(app.screen, Screen::Limits);
+}
+
+/// A click selects a trial and a second click opens it; `M` turns mouse
+/// capture off and on (an effect for the runtime).
+#[test]
+fn mouse_clicks_select_and_m_toggles_capture() {
+    use ratatui::crossterm::event::{KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    let _ = draw(&app, &Theme::default(), 80, 24);
+    let click = |row| {
+        Msg::Mouse(MouseEvent {
+            kind: MouseEventKind::Down(MouseButton::Left),
+            column: 10,
+            row,
+            modifiers: KeyModifiers::NONE,
+        })
+    };
+    // Title row, header row, then the trials (broken.csv, fb.csv.gz, knee.csv).
+    SyncRunner::send(&mut app, click(3));
+    assert_eq!(app.selected_entry().unwrap().file, "fb.csv.gz");
+    SyncRunner::send(&mut app, click(20));
+    assert_eq!(
+        app.selected_entry().unwrap().file,
+        "fb.csv.gz",
+        "below the list"
+    );
+    SyncRunner::send(&mut app, click(3));
+    assert_eq!(app.screen, Screen::Trial);
+    assert_eq!(app.open.as_deref(), Some("fb.csv.gz"));
+    assert!(!app.mouse);
+    let fx_m = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('M'))));
+    assert!(app.mouse);
+    assert!(matches!(fx_m[..], [super::msg::Effect::Mouse(true)]));
+    let fx_m = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('M'))));
+    assert!(matches!(fx_m[..], [super::msg::Effect::Mouse(false)]));
+    app.mouse_possible = false;
+    keys(&mut app, "M");
+    assert!(!app.mouse && app.message.as_ref().unwrap().1);
+}
+
+/// What a key can change, for telling whether it did anything.
+fn fingerprint(app: &App) -> String {
+    format!(
+        "{:?}",
+        (
+            (
+                app.screen,
+                &app.overlay,
+                app.selected,
+                app.variant,
+                app.joint
+            ),
+            (app.view.zoom, app.view.start_s, app.view.cursor_s),
+            (&app.message, app.filter_editing, app.sort, app.compare_col),
+            (
+                app.limits.edit.is_some(),
+                app.limits.col,
+                app.limits.row,
+                app.quit
+            ),
+            (app.views.kind, app.views.time_colour, app.calib.selected),
+            app.histogram.as_ref().map(|h| {
+                (
+                    h.span,
+                    h.suggestion.is_some(),
+                    h.overwrite.is_some(),
+                    h.joint,
+                )
+            }),
+            app.open_entry().map(|e| e.chosen),
+        )
+    )
+}
+
+/// Every hint in every screen's status bar names a key that has the hint's
+/// action, and pressing it there does something: it changes the state or
+/// asks the runtime for work (from a state where it can: Home after End,
+/// Left after Right, ...). Driven through `update`; nothing sleeps.
+#[test]
+fn every_hint_does_what_it_says() {
+    use super::keymap::{self, hints, Action, BINDINGS};
+    let fx = Fixture::new();
+    let base = fx.app();
+    let key_of = |a: Action| {
+        let b = BINDINGS.iter().find(|b| b.action == a).unwrap();
+        KeyEvent::from(b.code[0])
+    };
+    for (screen, setup) in [
+        ("trials", ""),
+        ("trial", "+"),
+        ("compare", ""),
+        ("limits", ""),
+        ("scatter", ""),
+        ("calibration", ""),
+        ("histogram", ""),
+    ] {
+        let mut app = base.clone();
+        shown(&mut app, screen, "knee.csv");
+        keys(&mut app, setup);
+        app.message = None;
+        let scope = super::render::scope_of(app.screen);
+        let line = super::render::hints(&app);
+        for h in hints(scope) {
+            let what = format!("{screen}: `{}` {}", h.keys, h.text);
+            assert!(line.contains(&format!("{} {}", h.keys, h.text)), "{what}");
+            assert_eq!(
+                keymap::action(&KeyEvent::from(h.key)),
+                Some(h.action),
+                "{what}"
+            );
+            let prep = match h.action {
+                Action::Home => Some(Action::End),
+                Action::End => Some(Action::Home),
+                Action::Left => Some(Action::Right),
+                Action::Right => Some(Action::Left),
+                Action::Down => Some(Action::Up),
+                Action::Up => Some(Action::Down),
+                Action::Scatter => Some(Action::Globe),
+                _ => None,
+            };
+            let acts = |from: &App| {
+                let mut a = from.clone();
+                let before = fingerprint(&a);
+                let effects = update(&mut a, Msg::Key(KeyEvent::from(h.key)));
+                !effects.is_empty() || fingerprint(&a) != before
+            };
+            let mut did = acts(&app);
+            if !did {
+                if let Some(p) = prep {
+                    let mut from = app.clone();
+                    SyncRunner::send(&mut from, Msg::Key(key_of(p)));
+                    from.message = None;
+                    did = acts(&from);
+                }
+            }
+            assert!(did, "{what} did nothing");
+        }
+    }
+}
+
+#[test]
+fn hints_are_dropped_whole_when_narrow() {
+    use super::render::fit_hints;
+    let line = "r run  v variant  ? help  q quit";
+    assert_eq!(fit_hints(line, 80), "r run  v variant  q quit  ? help");
+    assert_eq!(fit_hints(line, 24), "r run  v variant  ? help");
+    assert_eq!(fit_hints(line, 23), "r run  ? help");
+    assert_eq!(fit_hints(line, 6), "? help");
+    assert_eq!(fit_hints("a b  c d", 5), "a b");
 }

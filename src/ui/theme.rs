@@ -1,6 +1,7 @@
 //! Colour themes from `themes/*.toml`, embedded in the binary. Every style also
 //! carries modifiers where meaning matters, so that `NO_COLOR` loses nothing.
 
+use super::glyphs::Glyphs;
 use ratatui::style::{Color, Modifier, Style};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -42,6 +43,9 @@ pub struct Theme {
     pub cursor: Style,
     pub invalid: Style,
     pub edited: Style,
+    /// Plain ASCII markers in the charts and views (`--ascii`: fonts
+    /// without braille or block symbols).
+    pub ascii: bool,
 }
 
 fn modifier(name: &str) -> Result<Modifier, String> {
@@ -123,7 +127,23 @@ impl Theme {
             cursor: style("cursor")?,
             invalid: style("invalid")?,
             edited: style("edited")?,
+            ascii: false,
         })
+    }
+
+    /// The same theme with ASCII markers (`--ascii`) or not.
+    pub fn with_ascii(self, ascii: bool) -> Theme {
+        Theme { ascii, ..self }
+    }
+
+    /// The charts' marker set: braille (or, with `m`, dots) unless ASCII.
+    pub fn glyphs(&self, braille: bool) -> Glyphs {
+        Glyphs::new(braille, self.ascii)
+    }
+
+    /// Whether the theme has colours (none under `NO_COLOR`).
+    pub fn has_colour(&self) -> bool {
+        self.limit.fg.is_some() || self.raw.fg.is_some()
     }
 }
 

@@ -459,6 +459,20 @@ impl LimitsState {
             }
             6 => {
                 let v = num(text)?;
+                if !(0.0..=LAMBDA2_MAX).contains(&v) {
+                    return Err(format!(
+                        "lambda2 must be within 0..{LAMBDA2_MAX} (the thesis uses 30)"
+                    ));
+                }
+                let has_centroid = table
+                    .rows
+                    .iter()
+                    .any(|r| r.joint == joint && r.centroid_deg.is_some());
+                if v > 0.0 && !has_centroid {
+                    return Err(format!(
+                        "lambda2 weighs the centroid and {joint} has none: set its centroid first"
+                    ));
+                }
                 // lambda2 is the same on a joint's three rows.
                 for r in table.rows.iter_mut().filter(|r| r.joint == joint) {
                     r.lambda2 = v;
@@ -466,10 +480,24 @@ impl LimitsState {
             }
             _ => return Err("this column cannot be edited".into()),
         }
+        let r = &table.rows[self.row];
+        if let Some(c) = r.centroid_deg {
+            if r.lower_deg < r.upper_deg && !(r.lower_deg..=r.upper_deg).contains(&c) {
+                return Err(format!(
+                    "centroid {c} must lie within the limits [{}, {}]",
+                    r.lower_deg, r.upper_deg
+                ));
+            }
+        }
         LimitTable::parse(&table.to_csv(), "edit").map_err(|e| e.message)?;
         Ok((table, settings))
     }
 }
+
+/// The largest lambda2 the limits editor takes: the thesis weighs the
+/// centroid term with 30; a thousand already lets it outweigh any excursion
+/// (the term is at most sqrt(2) per sample).
+pub const LAMBDA2_MAX: f64 = 1000.0;
 
 /// What every screen shares.
 #[derive(Debug, Clone)]

@@ -357,6 +357,7 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
             settings_toml,
         } => vec![save_limits(&dir, &table_name, &table_csv, &settings_toml)],
         Effect::Debounce => vec![Msg::RecorrectDue],
+        Effect::Mouse(_) => vec![],
         Effect::Calibrations { dir } => vec![calibration::scan(&dir)],
         Effect::Histograms {
             trials,

@@ -44,8 +44,16 @@ pub fn action(c: &mut CalibState, app: &mut Workbench, a: Action) -> Reply {
     let n = c.entries.len();
     match a {
         Action::Back => return Reply::nav(Nav::To(Screen::Trials)),
-        Action::Up => c.selected = c.selected.saturating_sub(1),
-        Action::Down => c.selected = (c.selected + 1).min(n.saturating_sub(1)),
+        Action::Up
+        | Action::Down
+        | Action::PageUp
+        | Action::PageDown
+        | Action::Home
+        | Action::End => {
+            if let Some(i) = crate::ui::cells::list_move(a, c.selected, n, 10) {
+                c.selected = i;
+            }
+        }
         Action::Run => return enter(c, app).into(),
         _ => {}
     }

@@ -53,6 +53,9 @@ pub struct HistogramState {
     /// A suggested table waiting for y (save) or n (cancel), and the diff's scroll.
     pub suggestion: Option<Arc<Suggestion>>,
     pub scroll: usize,
+    /// A write over an existing file waiting for y (overwrite) or n: the
+    /// file and the CSV it would get.
+    pub overwrite: Option<(PathBuf, String)>,
 }
 
 /// Opens the screen over the trials the current screen has chosen.
@@ -82,6 +85,7 @@ pub fn open(hist: &mut Option<HistogramState>, app: &mut Workbench, from: Screen
         joint: 0,
         suggestion: None,
         scroll: 0,
+        overwrite: None,
     });
     vec![effect]
 }
@@ -162,6 +166,9 @@ pub fn action(hist: &mut Option<HistogramState>, app: &mut Workbench, a: Action)
     let Some(st) = hist.as_mut() else {
         return Reply::nav(Nav::To(Screen::Trials));
     };
+    if st.overwrite.is_some() {
+        return overwrite(st, app, a).into();
+    }
     if let Some(s) = st.suggestion.clone() {
         return confirm(hist, app, &s, a).into();
     }
@@ -173,8 +180,11 @@ pub fn action(hist: &mut Option<HistogramState>, app: &mut Workbench, a: Action)
     };
     match a {
         Action::Back => return Reply::nav(Nav::To(st.from)),
-        Action::Up => st.joint = st.joint.saturating_sub(1),
-        Action::Down => st.joint = (st.joint + 1).min(st.hists.len().saturating_sub(1)),
+        Action::Up | Action::Down | Action::PageUp | Action::PageDown => {
+            if let Some(i) = crate::ui::cells::list_move(a, st.joint, st.hists.len(), 10) {
+                st.joint = i;
+            }
+        }
         Action::Left if len.is_finite() => {
             span.start_s = (span.start_s - len).max(0.0);
             span.end_s = span.start_s + len;
@@ -253,11 +263,44 @@ fn save_centroids(hist: &mut Option<HistogramState>, app: &mut Workbench) -> Vec
         Ok(r) => r,
         Err(fx) => return fx,
     };
+    let path = centroids_path(app);
+    let csv = rows.centroids.to_csv();
+    // An existing file is not overwritten without asking (the only look at
+    // the disk on this screen: whether the file is there).
+    if path.exists() {
+        if let Some(st) = hist.as_mut() {
+            st.overwrite = Some((path, csv));
+        }
+        return vec![];
+    }
     vec![Effect::WriteTable {
-        path: centroids_path(app),
+        path,
         original: None,
-        csv: rows.centroids.to_csv(),
+        csv,
     }]
+}
+
+/// Keys while an overwrite is asked: y (or `w` again) writes, n or Esc keeps
+/// the file as it is.
+fn overwrite(st: &mut HistogramState, app: &mut Workbench, a: Action) -> Vec<Effect> {
+    match a {
+        Action::Yes | Action::Save => {
+            if let Some((path, csv)) = st.overwrite.take() {
+                return vec![Effect::WriteTable {
+                    path,
+                    original: None,
+                    csv,
+                }];
+            }
+        }
+        Action::No | Action::Back => {
+            if let Some((path, _)) = st.overwrite.take() {
+                app.info(format!("{} left as it was", path.display()));
+            }
+        }
+        _ => {}
+    }
+    vec![]
 }
 
 /// Reports a finished write in the status bar.
@@ -321,6 +364,34 @@ pub fn render(
     }
     if let Some(s) = &st.suggestion {
         diff_popup(app, s, st.scroll, theme, f, area);
+    }
+    if let Some((path, _)) = &st.overwrite {
+        let name = path
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        let lines = vec![
+            Line::from(format!("{name} exists in {}.", app.limits.dir.display())),
+            Line::from("Overwrite it with these centroids?"),
+            Line::from(""),
+            Line::from(vec![
+                Span::styled("y", theme.title),
+                Span::raw(" overwrite   "),
+                Span::styled("n", theme.title),
+                Span::raw(" keep the file"),
+            ]),
+        ];
+        let r = centred(area, 56, 6);
+        f.render_widget(Clear, r);
+        f.render_widget(
+            Paragraph::new(lines)
+                .wrap(ratatui::widgets::Wrap { trim: false })
+                .block(
+                    Block::new()
+                        .borders(Borders::ALL)
+                        .title(Span::styled(" Overwrite? ", theme.title)),
+                ),
+            r,
+        );
     }
 }
 
@@ -545,6 +616,22 @@ mod tests {
             c.contains("\njoint,axis,centroid_deg,sd_deg,samples,trials\nback,X,"),
             "{c}"
         );
+        // w again: the file exists, so it asks; n keeps it, y overwrites.
+        let path = root.join("joint_limits/centroids.csv");
+        std::fs::write(&path, "mine\n").unwrap();
+        key(&mut app, KeyCode::Char('w'));
+        assert!(app.histogram.as_ref().unwrap().overwrite.is_some());
+        let text = buffer_text(&draw(&app, &Theme::default(), 80, 24));
+        assert!(
+            text.contains("centroids.csv exists") && text.contains("y overwrite"),
+            "{text}"
+        );
+        key(&mut app, KeyCode::Char('n'));
+        assert!(app.histogram.as_ref().unwrap().overwrite.is_none());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "mine\n");
+        key(&mut app, KeyCode::Char('w'));
+        key(&mut app, KeyCode::Char('y'));
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), c);
         // The next 30 s of a 30 s trial hold nothing; Home comes back.
         key(&mut app, KeyCode::Right);
         assert!(app.histogram.as_ref().unwrap().hists.is_empty());

@@ -1,7 +1,7 @@
 //! The limits editor: the joint x axis table and the settings, edited in place.
 
 use crate::limits::HEADER;
-use crate::ui::cells::fit;
+use crate::ui::cells::{counter, fit, list_move};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Effect, Nav, Reply, Screen};
 use crate::ui::theme::Theme;
@@ -41,7 +41,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         ""
     };
     let mut heading = vec![Line::from(vec![
-        Span::raw(format!(" {} ", l.source)),
+        Span::raw(format!(" {} {} ", l.source, counter(l.row, l.rows()))),
         Span::styled(dirty, theme.edited),
     ])];
     if let Some(why) = &l.disk_error {
@@ -85,18 +85,35 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     }
     f.render_widget(Paragraph::new(lines), table);
     let mut msg = vec![];
+    // An edit of lambda2 changes the joint's three rows: said before it is made.
+    let whole_joint = joint_wide(app).map(|j| {
+        Span::styled(
+            format!("  lambda2 is one per joint: applies to {j}'s three rows (X, Y, Z)"),
+            theme.warn,
+        )
+    });
     match &l.edit {
         Some(e) => match &e.error {
             Some(m) => msg.push(Line::from(Span::styled(
                 format!("x invalid: {m}"),
                 theme.invalid,
             ))),
-            None => msg.push(Line::from(Span::styled("ok: Enter commits", theme.ok))),
+            None => msg.push(Line::from(
+                [Span::styled("ok: Enter commits", theme.ok)]
+                    .into_iter()
+                    .chain(whole_joint)
+                    .collect::<Vec<_>>(),
+            )),
         },
-        None => msg.push(Line::from(Span::styled(
-            "Enter edits the cell; edits re-run the open trial's joints",
-            theme.dim,
-        ))),
+        None => msg.push(Line::from(
+            [Span::styled(
+                "Enter edits the cell; edits re-run the open trial's joints",
+                theme.dim,
+            )]
+            .into_iter()
+            .chain(whole_joint)
+            .collect::<Vec<_>>(),
+        )),
     }
     f.render_widget(
         Paragraph::new(msg)
@@ -104,6 +121,16 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
             .block(Block::new().borders(Borders::TOP)),
         foot,
     );
+}
+
+/// The joint whose three rows the selected cell's edit changes (the
+/// lambda2 column), if it is such a cell.
+fn joint_wide(app: &Workbench) -> Option<&str> {
+    let l = &app.limits;
+    if l.col != 6 {
+        return None;
+    }
+    l.table.rows.get(l.row).map(|r| r.joint.as_str())
 }
 
 fn cell_spans(
@@ -189,10 +216,16 @@ pub fn action(app: &mut Workbench, from: Screen, a: Action) -> Reply {
     let n = l.rows();
     match a {
         Action::Back => return Reply::nav(Nav::To(from)),
-        Action::Up => l.row = l.row.saturating_sub(1),
-        Action::Down => l.row = (l.row + 1).min(n.saturating_sub(1)),
-        Action::PageUp => l.row = l.row.saturating_sub(10),
-        Action::PageDown => l.row = (l.row + 10).min(n.saturating_sub(1)),
+        Action::Up
+        | Action::Down
+        | Action::PageUp
+        | Action::PageDown
+        | Action::Home
+        | Action::End => {
+            if let Some(i) = list_move(a, l.row, n, 10) {
+                l.row = i;
+            }
+        }
         Action::Left => l.col = l.col.saturating_sub(1).max(FIRST_EDIT_COL),
         Action::Right => l.col = (l.col + 1).min(LAST_COL),
         Action::Enter => {
@@ -234,14 +267,25 @@ pub fn edit_key(app: &mut Workbench, k: KeyEvent) -> Reply {
             match applied {
                 Ok((table, settings)) => {
                     let settings_changed = settings != l.settings;
+                    let mut note = None;
                     if let Some(r) = l.table.rows.get(l.row) {
                         l.pending.get_or_insert_with(Vec::new).push(r.joint.clone());
+                        if l.col == 6 {
+                            note = Some(format!(
+                                "lambda2 of {} set to {} on its three rows",
+                                r.joint,
+                                text.trim()
+                            ));
+                        }
                     }
                     l.pending_all |= settings_changed;
                     l.table = table;
                     l.settings = settings;
                     l.edit = None;
                     app.settings = app.limits.settings.settings();
+                    if let Some(n) = note {
+                        app.info(n);
+                    }
                     return vec![Effect::Debounce].into();
                 }
                 Err(m) => {

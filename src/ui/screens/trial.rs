@@ -2,7 +2,8 @@
 
 use crate::limits::axis_name;
 use crate::metrics::JointFigures;
-use crate::ui::cells::{fit, num, sel};
+use crate::ui::cells::{counter, fit, list_move, num, sel};
+use crate::ui::glyphs::{sample, Glyphs};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Nav, Reply, Screen, ViewKind};
 use crate::ui::theme::Theme;
@@ -52,7 +53,12 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         f.render_widget(Paragraph::new("trial not loaded"), area);
         return;
     };
-    let left_w = if area.width >= 100 { 32 } else { 26 }.min(area.width / 2);
+    let left_w = match area.width {
+        100.. => 32,
+        80.. => 26,
+        _ => 22,
+    }
+    .min(area.width / 2);
     let [left, right] =
         Layout::horizontal([Constraint::Length(left_w), Constraint::Min(1)]).areas(area);
     let figs_h = 9.min(left.height / 2);
@@ -65,7 +71,10 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let mut lines = vec![Line::from(Span::styled(
         format!(
             "{}{:>6}{:>6}",
-            fit("joint", iw.saturating_sub(12)),
+            fit(
+                &format!("joint {}", counter(app.joint, joints.len())),
+                iw.saturating_sub(12)
+            ),
             "exc",
             "after"
         ),
@@ -116,18 +125,59 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let glitches = crate::ui::glitches::of_joint(l, &joint.name);
     // The optical reference beside the trial, per axis where it has one.
     let reference = l.reference.as_ref().and_then(|r| r.joints.get(&joint.name));
-    let [charts, foot] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
+    let glyphs = theme.glyphs(app.view.braille);
+    let [charts, legend_row, foot] = Layout::vertical([
+        Constraint::Min(1),
+        Constraint::Length(1),
+        Constraint::Length(1),
+    ])
+    .areas(right);
     let parts = Layout::vertical([Constraint::Ratio(1, 3); 3]).split(charts);
-    for axis in 0..3 {
-        let range = lim.map(|l| l.range_deg[axis]);
-        let centroid = lim.and_then(|l| l.centroid_deg).map(|c| c[axis]);
-        let mut title = vec![Span::styled(format!(" {} ", axis_name(axis)), theme.header)];
-        if let Some([lo, hi]) = range {
+    let data: Vec<ChartData> = (0..3)
+        .map(|axis| ChartData {
+            t,
+            origin,
+            axis,
+            raw: &raw,
+            cor: cor.as_deref().map(Vec::as_slice),
+            reference: reference.and_then(|r| r[axis].as_deref()),
+            range: lim.map(|l| l.range_deg[axis]),
+            centroid: lim.and_then(|l| l.centroid_deg).map(|c| c[axis]),
+            span: (s0, s1),
+            cursor: app.view.cursor_s,
+            glyphs,
+            glitches: crate::ui::glitches::markers(&glitches, &raw, axis, (s0, s1)),
+        })
+        .collect();
+    // One label width for the three charts: their time axes line up.
+    let frames: Vec<Option<Frame_>> = data
+        .iter()
+        .zip(parts.iter())
+        .map(|(d, a)| frame_of(d, *a, theme.ascii))
+        .collect();
+    let label_w = frames
+        .iter()
+        .flatten()
+        .flat_map(|fr| fr.labels.iter().map(|(_, s)| s.chars().count()))
+        .max()
+        .unwrap_or(1) as u16;
+    for (axis, (d, fr)) in data.iter().zip(frames).enumerate() {
+        let Some(fr) = fr else { continue };
+        let mut title = vec![Span::styled(
+            format!(
+                " {}{} ",
+                axis_name(axis),
+                if theme.ascii { " deg" } else { "" }
+            ),
+            theme.header,
+        )];
+        if let Some([lo, hi]) = d.range {
             title.push(Span::styled(format!("[{lo}, {hi}] "), theme.limit));
         }
-        if let Some(c) = centroid {
+        if let Some(c) = d.centroid {
             title.push(Span::styled(format!("c {c} "), theme.centroid));
         }
+        title.push(Span::styled("at cursor ", theme.dim));
         title.push(Span::styled(
             format!("raw {} ", num(raw.get(ci).map(|a| a[axis]), 0)),
             theme.raw,
@@ -138,32 +188,68 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
                 theme.corrected,
             ));
         }
-        let ref_axis = reference.and_then(|r| r[axis].as_deref());
+        let ref_axis = d.reference;
         if let Some(r) = ref_axis {
             let v = r.get(ci).copied().filter(|v| v.is_finite());
             title.push(Span::styled(format!("ref {} ", num(v, 0)), theme.ok));
         }
-        chart(
-            f,
-            parts[axis],
-            theme,
-            Line::from(title),
-            ChartData {
-                t,
-                origin,
-                axis,
-                raw: &raw,
-                cor: cor.as_deref().map(Vec::as_slice),
-                reference: ref_axis,
-                range,
-                centroid,
-                span: (s0, s1),
-                cursor: app.view.cursor_s,
-                braille: app.view.braille,
-                glitches: crate::ui::glitches::markers(&glitches, &raw, axis, (s0, s1)),
-            },
-        );
+        chart(f, parts[axis], theme, Line::from(title), d, fr, label_w);
     }
+    // (glyph, name, short name, style) of what the charts show.
+    let mut legend = vec![(sample(glyphs.raw), "raw".to_string(), "", theme.raw)];
+    if cor.is_some() {
+        legend.push((
+            sample(glyphs.corrected),
+            app.variant.to_string(),
+            "",
+            theme.corrected,
+        ));
+    }
+    if reference.is_some() {
+        legend.push((sample(glyphs.reference), "ref".into(), "", theme.ok));
+    }
+    if lim.is_some() {
+        legend.push((sample(glyphs.limit), "limits".into(), "lim", theme.limit));
+    }
+    if lim.is_some_and(|l| l.centroid_deg.is_some()) {
+        legend.push((
+            sample(glyphs.centroid),
+            "centroid".into(),
+            "cen",
+            theme.centroid,
+        ));
+    }
+    // A vertical line: one of its glyph.
+    let cursor: String = sample(glyphs.cursor).chars().take(1).collect();
+    legend.push((cursor, "cursor".into(), "cur", theme.cursor));
+    if !glitches.is_empty() {
+        legend.push((sample(glyphs.glitch), "glitch".into(), "gl", theme.warn));
+    }
+    let full: usize = legend
+        .iter()
+        .map(|(g, n, _, _)| g.chars().count() + n.chars().count() + 3)
+        .sum::<usize>()
+        + 1;
+    let mut spans = vec![Span::raw(" ")];
+    for (glyph, name, short, style) in legend {
+        if full <= legend_row.width as usize {
+            spans.push(Span::styled(glyph, style));
+            spans.push(Span::raw(format!(" {name}  ")));
+        } else {
+            // Narrow: one glyph and a short name each.
+            spans.push(Span::styled(
+                glyph.chars().take(1).collect::<String>(),
+                style,
+            ));
+            let name = if short.is_empty() {
+                name
+            } else {
+                short.to_string()
+            };
+            spans.push(Span::raw(format!("{name} ")));
+        }
+    }
+    f.render_widget(Paragraph::new(Line::from(spans)), legend_row);
     let note = e
         .variant_note_short(app.variant)
         .filter(|_| e.running.is_none());
@@ -176,18 +262,31 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     } else {
         "not run: r runs all variants".to_string()
     };
+    // A running correction first: it must not be cut at narrow widths; the
+    // span and cursor shorter there.
+    let zoom = 1u32 << app.view.zoom.min(16);
+    let (running, done) = if e.running.is_some() {
+        (format!(" {status} "), String::new())
+    } else {
+        (String::new(), status)
+    };
+    let place = if foot.width >= 60 {
+        format!(
+            " t {s0:.1}-{s1:.1} s  x{zoom}  cursor {:.2} s  ",
+            app.view.cursor_s
+        )
+    } else {
+        format!(" {s0:.0}-{s1:.0}s x{zoom} @{:.2}s ", app.view.cursor_s)
+    };
     f.render_widget(
         Paragraph::new(Line::from(vec![
-            Span::raw(format!(
-                " t {s0:.1}-{s1:.1} s  x{}  cursor {:.2} s  ",
-                1u32 << app.view.zoom.min(16),
-                app.view.cursor_s
-            )),
+            Span::styled(running, theme.warn),
+            Span::raw(place),
             Span::styled(
                 crate::ui::glitches::footer(&glitches, app.view.cursor_s).unwrap_or_default(),
                 theme.warn,
             ),
-            Span::styled(status, theme.dim),
+            Span::styled(done, theme.dim),
             Span::styled(
                 l.reference
                     .as_ref()
@@ -229,27 +328,88 @@ struct ChartData<'a> {
     centroid: Option<f64>,
     span: (f64, f64),
     cursor: f64,
-    braille: bool,
+    glyphs: Glyphs,
     /// Glitch markers `(time, angle)` of the joint's IMUs in view.
     glitches: Vec<(f64, f64)>,
 }
 
-fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
+/// What a chart shows before it is drawn: the traces reduced to the columns
+/// of its plot, the angle bounds and the y-axis tick labels.
+struct Frame_ {
+    raw: Vec<(f64, f64)>,
+    /// The optical reference's points (finite ones only).
+    reference: Vec<(f64, f64)>,
+    cor: Vec<(f64, f64)>,
+    /// Angle bounds of the plot, degrees.
+    lo: f64,
+    hi: f64,
+    /// (value, label) of the round ticks inside the bounds.
+    labels: Vec<(f64, String)>,
+}
+
+/// Round tick values inside `[lo, hi]`: multiples of a step of 1, 2 or 5
+/// times a power of ten, at most `max` of them (at least one step is tried
+/// until few enough fit; none when the bounds are not finite).
+pub fn ticks(lo: f64, hi: f64, max: usize) -> (f64, Vec<f64>) {
+    let max = max.max(1);
+    if !(lo.is_finite() && hi.is_finite()) || hi <= lo {
+        return (1.0, vec![]);
+    }
+    let mut decade = 10f64.powf(((hi - lo) / max as f64).log10().floor());
+    loop {
+        for m in [1.0, 2.0, 5.0] {
+            let step = decade * m;
+            let (first, last) = ((lo / step).ceil() as i64, (hi / step).floor() as i64);
+            if last < first || ((last - first + 1) as usize) <= max {
+                // `+ 0.0` turns -0 into 0.
+                let vals = (first..=last).map(|k| k as f64 * step + 0.0).collect();
+                return (step, vals);
+            }
+        }
+        decade *= 10.0;
+    }
+}
+
+/// A tick label: the value with as many decimals as the step needs, and the
+/// unit (degrees; ASCII charts name it in the title instead).
+fn tick_label(v: f64, step: f64, ascii: bool) -> String {
+    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    let unit = if ascii { "" } else { "°" };
+    format!("{v:.decimals$}{unit}")
+}
+
+/// The row of `v` in a plot `height` rows tall over `[lo, hi]`, from the top
+/// (as the chart's one-per-cell markers place it).
+fn row_of(v: f64, lo: f64, hi: f64, height: u16) -> u16 {
+    let h = f64::from(height.saturating_sub(1));
+    ((hi - v) * h / (hi - lo)).round().clamp(0.0, h) as u16
+}
+
+/// The plot's content and axis for a chart in `area` (None when too small).
+fn frame_of(d: &ChartData, area: Rect, ascii: bool) -> Option<Frame_> {
     if area.height < 2 || area.width < 10 {
-        return;
+        return None;
     }
     let (s0, s1) = d.span;
-    let label_w = 5u16;
-    let cols = area.width.saturating_sub(label_w + 1).max(1) as usize;
-    let per_col = if d.braille { 2 } else { 1 };
-    let raw = envelope(d.t, d.origin, |i| d.raw[i][d.axis], s0, s1, cols * per_col);
+    // The plot is narrower by the labels and the axis: a few columns of
+    // envelope more than needed cost nothing visible.
+    let cols = area.width.saturating_sub(6).max(1) as usize;
+    let raw_per_col = crate::ui::glyphs::dots_per_cell(d.glyphs.raw).0;
+    let raw = envelope(
+        d.t,
+        d.origin,
+        |i| d.raw[i][d.axis],
+        s0,
+        s1,
+        cols * raw_per_col,
+    );
     let cor = d
         .cor
-        .map(|c| envelope(d.t, d.origin, |i| c[i][d.axis], s0, s1, cols * per_col))
+        .map(|c| envelope(d.t, d.origin, |i| c[i][d.axis], s0, s1, cols))
         .unwrap_or_default();
     let reference: Vec<(f64, f64)> = d
         .reference
-        .map(|r| envelope(d.t, d.origin, |i| r[i], s0, s1, cols * per_col))
+        .map(|r| envelope(d.t, d.origin, |i| r[i], s0, s1, cols))
         .unwrap_or_default()
         .into_iter()
         .filter(|(_, y)| y.is_finite())
@@ -271,80 +431,108 @@ fn chart(f: &mut Frame, area: Rect, theme: &Theme, title: Line, d: ChartData) {
     }
     let pad = ((hi - lo) * 0.05).max(0.5);
     let (lo, hi) = (lo - pad, hi + pad);
+    // A tick at most every other row.
+    let plot_h = area.height.saturating_sub(1) as usize;
+    let (step, vals) = ticks(lo, hi, plot_h.div_ceil(2).clamp(1, 5));
+    let labels = vals
+        .into_iter()
+        .map(|v| (v, tick_label(v, step, ascii)))
+        .collect();
+    Some(Frame_ {
+        raw,
+        reference,
+        cor,
+        lo,
+        hi,
+        labels,
+    })
+}
+
+fn chart(
+    f: &mut Frame,
+    area: Rect,
+    theme: &Theme,
+    title: Line,
+    d: &ChartData,
+    fr: Frame_,
+    label_w: u16,
+) {
+    let (s0, s1) = d.span;
+    let (lo, hi) = (fr.lo, fr.hi);
+    let g = d.glyphs;
     let lower: Vec<(f64, f64)>;
     let upper: Vec<(f64, f64)>;
     let centre: Vec<(f64, f64)>;
     let cursor = vec![(d.cursor, lo), (d.cursor, hi)];
-    let marker = if d.braille {
-        Marker::Braille
-    } else {
-        Marker::Dot
-    };
     // Limit lines first: a later dataset overwrites whole cells.
     let mut sets = vec![];
     if let Some([a, b]) = d.range {
         lower = vec![(s0, a), (s1, a)];
         upper = vec![(s0, b), (s1, b)];
-        sets.push(line(&lower, theme.limit, marker));
-        sets.push(line(&upper, theme.limit, marker));
+        sets.push(line(&lower, theme.limit, g.limit));
+        sets.push(line(&upper, theme.limit, g.limit));
     }
     if let Some(c) = d.centroid {
         centre = vec![(s0, c), (s1, c)];
-        sets.push(line(&centre, theme.centroid, marker));
+        sets.push(line(&centre, theme.centroid, g.centroid));
     }
     if d.cursor >= s0 && d.cursor <= s1 {
-        sets.push(line(&cursor, theme.cursor, marker));
+        sets.push(line(&cursor, theme.cursor, g.cursor));
     }
-    sets.push(line(&raw, theme.raw, marker));
-    if !cor.is_empty() {
-        sets.push(line(&cor, theme.corrected, marker));
+    sets.push(line(&fr.raw, theme.raw, g.raw));
+    if !fr.cor.is_empty() {
+        sets.push(line(&fr.cor, theme.corrected, g.corrected));
     }
-    // The reference as points of the other marker (named `ref` in the title),
-    // so it reads apart from raw and corrected without colour.
-    if !reference.is_empty() {
-        let other = if d.braille {
-            Marker::Dot
-        } else {
-            Marker::Braille
-        };
+    // The reference as points of its own glyph (named `ref` in the title and
+    // the legend), so it reads apart from raw and corrected without colour.
+    if !fr.reference.is_empty() {
         sets.push(
             Dataset::default()
-                .data(&reference)
+                .data(&fr.reference)
                 .graph_type(GraphType::Scatter)
-                .marker(other)
+                .marker(g.reference)
                 .style(theme.ok),
         );
     }
-    // Glitches last, as full blocks: a glyph of their own, not colour alone.
+    // Glitches last: a glyph of their own, not colour alone.
     if !d.glitches.is_empty() {
         sets.push(
             Dataset::default()
                 .data(&d.glitches)
                 .graph_type(GraphType::Scatter)
-                .marker(Marker::Block)
+                .marker(g.glitch)
                 .style(theme.warn),
         );
     }
-    let y_labels = if area.height >= 7 {
-        vec![
-            format!("{lo:.0}"),
-            format!("{:.0}", (lo + hi) / 2.0),
-            format!("{hi:.0}"),
-        ]
-    } else {
-        vec![format!("{lo:.0}"), format!("{hi:.0}")]
-    };
+    // Blank labels of the common width keep the plot where the other charts
+    // have theirs; the round ticks are written at their own rows below.
+    let label_w = label_w.min(area.width / 3);
+    let blank = " ".repeat(label_w as usize);
     let chart = Chart::new(sets)
         .block(Block::new().borders(Borders::TOP).title(title))
         .x_axis(Axis::default().bounds([s0, s1]))
         .y_axis(
             Axis::default()
                 .bounds([lo, hi])
-                .labels(y_labels)
+                .labels(vec![blank.clone(), blank])
                 .style(theme.dim),
         )
         .legend_position(None);
     f.render_widget(chart, area);
+    let plot_h = area.height.saturating_sub(1);
+    let buf = f.buffer_mut();
+    for (v, label) in &fr.labels {
+        let y = area.y + 1 + row_of(*v, lo, hi, plot_h);
+        // Right-aligned; a label wider than the column loses its left end.
+        let w = label_w as usize;
+        let n = label.chars().count();
+        let text: String = if n > w {
+            label.chars().skip(n - w).collect()
+        } else {
+            format!("{label:>w$}")
+        };
+        buf.set_string(area.x, y, text, theme.dim);
+    }
 }
 
 fn figures_panel(
@@ -357,16 +545,23 @@ fn figures_panel(
 ) {
     let before = figures_of(e.figures(None), joint);
     let after = figures_of(e.figures(Some(app.variant)), joint);
+    // Number columns as wide as the panel allows (6, or 5 when narrow).
+    let nw = (area.width.saturating_sub(7) as usize / 3).clamp(4, 6);
+    // One decimal while a space is left before the number, else none.
+    let cell = |v: Option<f64>| match v {
+        Some(v) if v.is_finite() && format!("{v:.1}").len() >= nw => format!("{v:>nw$.0}"),
+        v => num(v, nw),
+    };
     let row = |label: &str, v: Option<[f64; 3]>| {
         let mut s = format!("{label:<6}");
         for k in 0..3 {
-            s.push_str(&num(v.map(|v| v[k]), 6));
+            s.push_str(&cell(v.map(|v| v[k])));
         }
         Line::from(s)
     };
     let mut lines = vec![
         Line::from(Span::styled(
-            format!("{:<6}{:>6}{:>6}{:>6}", "deg", "X", "Y", "Z"),
+            format!("{:<6}{:>nw$}{:>nw$}{:>nw$}", "deg", "X", "Y", "Z"),
             theme.header,
         )),
         row("out%b", before.map(|f| f.excursion.pct_outside)),
@@ -383,18 +578,17 @@ fn figures_panel(
     lines.push(Line::from(format!(
         "{:<6}{}",
         "corr",
-        num(
+        cell(
             after
                 .and_then(|f| f.shift.as_ref())
-                .map(|s| s.mean_correction_angle_deg),
-            6
+                .map(|s| s.mean_correction_angle_deg)
         )
     )));
     f.render_widget(
         Paragraph::new(lines).block(
             Block::new()
                 .borders(Borders::TOP | Borders::RIGHT)
-                .title(" figures "),
+                .title(" figures (? legend) "),
         ),
         area,
     );
@@ -424,8 +618,11 @@ pub fn action(app: &mut Workbench, a: Action) -> Reply {
     let step = (s1 - s0) / 50.0;
     match a {
         Action::Back => return Reply::nav(Nav::To(Screen::Trials)),
-        Action::Up => app.joint = app.joint.saturating_sub(1),
-        Action::Down => app.joint = (app.joint + 1).min(joints.saturating_sub(1)),
+        Action::Up | Action::Down | Action::PageUp | Action::PageDown => {
+            if let Some(i) = list_move(a, app.joint, joints, 10) {
+                app.joint = i;
+            }
+        }
         Action::ZoomIn => zoom(app, true),
         Action::ZoomOut => zoom(app, false),
         Action::Left => app.view.start_s = (s0 - (s1 - s0) / 4.0).max(0.0),
@@ -556,10 +753,17 @@ mod tests {
             let text = buffer_text(&draw(&app, &Theme::default(), w, h));
             // The footer names the lag where it has room.
             assert!(w < 120 || text.contains("ref lag +0.40 s"), "{text}");
-            // Named in each chart's title, drawn with the other marker.
-            let named = text.matches(" ref ").count() - text.matches(" ref lag").count();
-            assert_eq!(named, 3, "{text}");
-            assert!(text.contains('•'), "{text}");
+            // Named in the legend, drawn with its own glyph, and its value at
+            // the cursor in each chart's title where the title has room.
+            assert!(text.contains("∘ref") || text.contains("∘∘ ref"), "{text}");
+            assert!(text.matches('∘').count() > 20, "{text}");
+            let named = text
+                .match_indices(" ref ")
+                .filter(|(i, _)| {
+                    text[i + 5..].starts_with(|c: char| c.is_ascii_digit() || c == '-')
+                })
+                .count();
+            assert!(w < 80 || named == 3, "{text}");
             insta::assert_snapshot!(format!("trial_reference_{w}x{h}"), text);
         }
     }

@@ -1,7 +1,7 @@
 //! The trials screen: every trial file of the folder, its status and figures.
 
 use crate::acm::Variant;
-use crate::ui::cells::{fit, num, sel};
+use crate::ui::cells::{counter, fit, list_move, num, sel};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Nav, Reply};
 use crate::ui::theme::Theme;
@@ -17,28 +17,68 @@ fn short_name(v: Variant) -> &'static str {
     v.info().short
 }
 
+/// The variant columns' headers, the first marked `<` when columns are
+/// scrolled out of view on the left.
+fn variant_headers(variants: &[Variant], more_left: bool) -> String {
+    let mut h: String = variants
+        .iter()
+        .map(|v| format!("{:>7}", short_name(*v)))
+        .collect();
+    if more_left {
+        h.replace_range(0..1, "<");
+    }
+    h
+}
+
 /// The name column's header: the filter first while there is one, so it
 /// stays in view however narrow the column.
-fn name_header(filter: &str, sort: &str) -> String {
+fn name_header(filter: &str, sort: &str, position: &str) -> String {
     if filter.is_empty() {
-        format!("trial (sort: {sort})")
+        format!("trial {position} (sort: {sort})")
     } else {
-        format!("{}  (sort: {sort})", filter.trim_start())
+        format!("{}  {position} (sort: {sort})", filter.trim_start())
     }
 }
 
-pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
+/// The list and the details below it.
+fn areas(area: Rect) -> [Rect; 2] {
     let details_h = if area.height >= 16 { 5 } else { 0 };
-    let [list, details] =
-        Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area);
-    // Variant status columns: all that fit beside a 20-character name, at
-    // least the three ACM variants (the baselines show on wider terminals).
+    Layout::vertical([Constraint::Min(1), Constraint::Length(details_h)]).areas(area)
+}
+
+/// The first list row shown, for a list `rows` tall.
+fn first_row(app: &Workbench, rows: usize) -> usize {
+    app.selected.saturating_sub(rows.saturating_sub(1))
+}
+
+/// The trial (index into the visible list) drawn at row `y` of the screen,
+/// `body` being the screen's area as last drawn.
+pub fn row_at(app: &Workbench, body: Rect, y: u16) -> Option<usize> {
+    let [list, _] = areas(body);
+    let rows = list.height.saturating_sub(1) as usize;
+    let k = y.checked_sub(list.y + 1)? as usize;
+    let i = first_row(app, rows) + k;
+    (k < rows && i < app.visible().len()).then_some(i)
+}
+
+pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
+    let [list, details] = areas(area);
+    let details_h = details.height;
+    // Variant status columns: as many as fit beside a 20-character name;
+    // when not all fit they scroll so that the variant shown (`v`) is in
+    // view, `<` and `>` marking columns out of view.
     let base = 2 + 8 + 6 + 5 + 7 + 7;
-    let shown = (3..=Variant::ALL.len())
+    let all = Variant::ALL.len();
+    let shown = (1..=all)
         .rev()
         .find(|k| list.width as usize >= base + k * 7 + 20)
-        .unwrap_or(3);
-    let variants = &Variant::ALL[..shown];
+        .unwrap_or(1);
+    let cur = Variant::ALL
+        .iter()
+        .position(|v| *v == app.variant)
+        .unwrap_or(0);
+    let start = cur.saturating_sub(shown - 1).min(all - shown);
+    let variants = &Variant::ALL[start..start + shown];
     let fixed = base + shown * 7;
     let nw = (list.width as usize).saturating_sub(fixed).max(8);
     let filter = if app.filter_editing || !app.filter.is_empty() {
@@ -53,22 +93,30 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let mut lines = vec![Line::from(Span::styled(
         format!(
             "  {}{:>8}{:>6}{:>5}{}{:>7}{:>7}",
-            fit(&name_header(&filter, app.sort.name()), nw),
+            fit(
+                &name_header(
+                    &filter,
+                    app.sort.name(),
+                    &counter(app.selected, app.visible().len())
+                ),
+                nw
+            ),
             "dur s",
             "Hz",
             "IMUs",
-            variants
-                .iter()
-                .map(|v| format!("{:>7}", short_name(*v)))
-                .collect::<String>(),
-            "exc",
-            app.variant.name().chars().take(6).collect::<String>(),
+            variant_headers(variants, start > 0),
+            if start + shown < all {
+                ">   exc"
+            } else {
+                "exc"
+            },
+            short_name(app.variant),
         ),
         theme.header,
     ))];
     let visible = app.visible();
     let rows = list.height.saturating_sub(1) as usize;
-    let first = app.selected.saturating_sub(rows.saturating_sub(1));
+    let first = first_row(app, rows);
     for (k, &i) in visible.iter().enumerate().skip(first).take(rows) {
         let e = &app.trials[i];
         let selected = k == app.selected;
@@ -162,10 +210,16 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
 pub fn action(app: &mut Workbench, a: Action) -> Reply {
     let n = app.visible().len();
     match a {
-        Action::Up => app.selected = app.selected.saturating_sub(1),
-        Action::Down => app.selected = (app.selected + 1).min(n.saturating_sub(1)),
-        Action::PageUp => app.selected = app.selected.saturating_sub(10),
-        Action::PageDown => app.selected = (app.selected + 10).min(n.saturating_sub(1)),
+        Action::Up
+        | Action::Down
+        | Action::PageUp
+        | Action::PageDown
+        | Action::Home
+        | Action::End => {
+            if let Some(i) = list_move(a, app.selected, n, 10) {
+                app.selected = i;
+            }
+        }
         Action::Filter => app.filter_editing = true,
         Action::Back => app.filter.clear(),
         Action::Sort => {

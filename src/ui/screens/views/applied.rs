@@ -85,7 +85,7 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
     let cols = area.width.saturating_sub(8).max(2) as usize;
     let per_col = if app.view.braille { 2 } else { 1 };
     let s = applied.sampled(0.0, d, cols * per_col);
-    let mk = marker(app);
+    let mk = marker(app, theme);
     let angle: Vec<(f64, f64)> = s.iter().map(|(t, c)| (*t, c.angle_deg)).collect();
     let centres: Vec<(f64, f64)> = applied
         .centres_s

@@ -7,8 +7,8 @@
 use super::scatter::{colouring, legend_of};
 use super::Ctx;
 use super::{
-    colour, joint_data, marker, resolution, square_around, RasterShape, BAND_COLOUR, CLASS_COLOURS,
-    TIME_COLOURS,
+    colour, draw_keys, joint_data, key_markers, marker, resolution, square_around, RasterShape,
+    BAND_COLOUR, CLASS_COLOURS, TIME_COLOURS,
 };
 use crate::analysis::globe::{
     band_outline, band_raster, extent, globe_raster, grid_lines, rect_outline, GlobeView, JointAxes,
@@ -76,7 +76,8 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
     ])
     .areas(area);
     let [left, right] = Layout::horizontal([Constraint::Ratio(1, 2); 2]).areas(panels);
-    let mk = marker(app);
+    let mk = marker(app, theme);
+    let keys = key_markers(app, theme, c == Colouring::Time);
     // Zoom to the band and the samples (the thesis' plots show that region).
     let mut outlines = vec![band_outline(&range, axes, 24)];
     for a in std::iter::once(&d.raw).chain(d.cor.as_ref()) {
@@ -154,10 +155,7 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
                 });
                 ctx.layer();
                 if let Some(r) = &raster {
-                    ctx.draw(&RasterShape {
-                        raster: r,
-                        colours: &colours,
-                    });
+                    draw_keys(ctx, r, &colours, &keys, mk);
                 }
             });
         f.render_widget(canvas, side);

@@ -5,6 +5,7 @@
 use super::Ctx;
 use crate::acm::{ImuHeading, Variant};
 use crate::ui::cells::fit;
+use crate::ui::glyphs::SERIES;
 use crate::ui::theme::Theme;
 use crate::ui::workbench::{TrialEntry, Workbench};
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -30,9 +31,12 @@ pub fn shown_variant(app: &Workbench, e: &TrialEntry) -> Option<Variant> {
         .find(|v| v.heading() && e.results.contains_key(v))
 }
 
-/// Markers of the drifting IMUs in turn (with their glyph for the table, which
-/// is the legend), so colour is never the only cue.
-const MARKERS: [(Marker, &str); 3] = [(Marker::Dot, "•"), (Marker::Block, "█"), (Marker::Bar, "▄")];
+/// The marker of the `k`-th drifting IMU: its label character (`1`, `2`, ...,
+/// then letters), which the table shows beside its name, so that colour is
+/// never the only cue.
+fn marker_of(k: usize) -> Marker {
+    Marker::Custom(char::from(SERIES[k % SERIES.len()]))
+}
 
 /// Line styles of the drifting IMUs, in turn.
 fn styles(theme: &Theme) -> [Style; 5] {
@@ -92,18 +96,11 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
         let text = format!("  no heading drift found (no window's heading beyond {SHOWN_DEG} deg)");
         f.render_widget(Paragraph::new(Span::styled(text, theme.ok)), plot);
     }
-    chart(&drifting, duration, app.view.braille, theme, f, plot);
+    chart(&drifting, duration, theme, f, plot);
     rows(c, &drifting, theme, f, table);
 }
 
-fn chart(
-    hs: &[&ImuHeading],
-    duration: f64,
-    braille: bool,
-    theme: &Theme,
-    f: &mut Frame,
-    area: Rect,
-) {
+fn chart(hs: &[&ImuHeading], duration: f64, theme: &Theme, f: &mut Frame, area: Rect) {
     if area.height < 3 || area.width < 12 || hs.is_empty() {
         return;
     }
@@ -123,20 +120,12 @@ fn chart(
     }
     let pad = ((hi - lo) * 0.05).max(0.5);
     let (lo, hi) = (lo - pad, hi + pad);
-    let marker_of = |k: usize| {
-        if braille {
-            Marker::Braille
-        } else {
-            MARKERS[k % MARKERS.len()].0
-        }
-    };
-    let marker = marker_of(0);
     let zero = vec![(0.0, 0.0), (duration, 0.0)];
     let mut sets = vec![Dataset::default()
         .data(&zero)
         .graph_type(GraphType::Line)
-        .marker(marker)
-        .style(theme.limit)];
+        .marker(theme.glyphs(true).centroid)
+        .style(theme.dim)];
     let st = styles(theme);
     for (k, s) in series.iter().enumerate() {
         sets.push(
@@ -187,7 +176,7 @@ fn rows(c: &crate::acm::Correction, hs: &[&ImuHeading], theme: &Theme, f: &mut F
         let (rate, at) = steepest(h).unwrap_or((0.0, 0.0));
         lines.push(Line::from(vec![
             Span::styled(
-                format!("{} ", MARKERS[k % MARKERS.len()].1),
+                format!("{} ", char::from(SERIES[k % SERIES.len()])),
                 st[k % st.len()],
             ),
             Span::raw(format!(

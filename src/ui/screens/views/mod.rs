@@ -13,6 +13,7 @@ pub mod stick;
 
 use crate::analysis::scatter::Raster;
 use crate::model::Joint;
+use crate::ui::glyphs::{dots_per_cell, TIME_DIGITS};
 use crate::ui::keymap::Action;
 pub use crate::ui::msg::ViewKind;
 use crate::ui::msg::{Nav, Reply, Screen};
@@ -21,7 +22,7 @@ use crate::ui::workbench::{JointAngles, TrialEntry, Workbench};
 use ratatui::layout::Rect;
 use ratatui::style::Color;
 use ratatui::symbols::Marker;
-use ratatui::widgets::canvas::{Painter, Shape};
+use ratatui::widgets::canvas::{Context, Painter, Shape};
 use ratatui::widgets::Paragraph;
 use ratatui::Frame;
 
@@ -193,12 +194,77 @@ pub fn colour(theme: &Theme, c: Color) -> Color {
     }
 }
 
-/// The canvas marker of the views (`m` switches braille / dots).
-pub fn marker(app: &Workbench) -> Marker {
-    if app.view.braille {
-        Marker::Braille
+/// The canvas marker of the views (`m` switches braille / dots; `--ascii`
+/// plain characters).
+pub fn marker(app: &Workbench, theme: &Theme) -> Marker {
+    theme.glyphs(app.view.braille).fine()
+}
+
+/// The marker of each key of a point raster (limit class or time band), so
+/// that keys differ by glyph, not by colour alone: the limit classes by
+/// [`Glyphs::classes`](crate::ui::glyphs::Glyphs), the time bands by digit
+/// when there is no colour.
+pub fn key_markers(app: &Workbench, theme: &Theme, time: bool) -> Vec<Marker> {
+    let g = theme.glyphs(app.view.braille);
+    if !time {
+        g.classes.to_vec()
+    } else if theme.has_colour() {
+        vec![g.fine(); TIME_COLOURS.len()]
     } else {
-        Marker::Dot
+        TIME_DIGITS.iter().map(|&c| Marker::Custom(c)).collect()
+    }
+}
+
+/// One key of a raster made for a finer marker, drawn with a coarser one:
+/// dot `(c, r)` lands on dot `(c / div.0, r / div.1)`.
+struct KeyShape<'a> {
+    raster: &'a Raster,
+    key: u8,
+    colour: Color,
+    div: (usize, usize),
+}
+
+impl Shape for KeyShape<'_> {
+    fn draw(&self, painter: &mut Painter) {
+        for (c, r, k) in self.raster.dots() {
+            if k == self.key {
+                painter.paint(c / self.div.0, r / self.div.1, self.colour);
+            }
+        }
+    }
+}
+
+/// Draws the keys of `raster` (made at the resolution of `main`) each on a
+/// layer of its own marker, later keys on top; the context is left with
+/// `main`.
+pub fn draw_keys(
+    ctx: &mut Context,
+    raster: &Raster,
+    colours: &[Color],
+    markers: &[Marker],
+    main: Marker,
+) {
+    let (mx, my) = dots_per_cell(main);
+    for (k, (m, c)) in markers.iter().zip(colours).enumerate() {
+        ctx.marker(*m);
+        let (gx, gy) = dots_per_cell(*m);
+        ctx.draw(&KeyShape {
+            raster,
+            key: k as u8,
+            colour: *c,
+            div: ((mx / gx).max(1), (my / gy).max(1)),
+        });
+    }
+    ctx.marker(main);
+}
+
+/// What a marker's point looks like in a legend.
+pub fn point_glyph(m: Marker) -> String {
+    match m {
+        Marker::Braille => "⠿".into(),
+        Marker::Dot => "•".into(),
+        Marker::Custom(c) => c.to_string(),
+        other => crate::ui::glyphs::sample(other).chars().take(1).collect(),
     }
 }
 

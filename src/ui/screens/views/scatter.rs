@@ -4,7 +4,8 @@
 
 use super::Ctx;
 use super::{
-    colour, joint_data, marker, resolution, RasterShape, BAND_COLOUR, CLASS_COLOURS, TIME_COLOURS,
+    colour, draw_keys, joint_data, key_markers, marker, point_glyph, resolution, BAND_COLOUR,
+    CLASS_COLOURS, TIME_COLOURS,
 };
 use crate::analysis::scatter::{
     axis_bounds, scatter_rasters, ClassCounts, Colouring, LimitClass, Raster, PROJECTIONS,
@@ -14,6 +15,7 @@ use crate::ui::theme::Theme;
 use crate::ui::workbench::TrialEntry;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Style;
+use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::canvas::{Canvas, Rectangle};
 use ratatui::widgets::{Block, Borders, Paragraph};
@@ -28,25 +30,29 @@ pub fn colouring(app: &Ctx) -> Colouring {
     }
 }
 
-/// The legend: the colours, then each panel's share of samples per class
-/// (within / near / beyond, percent), or the time bands.
+/// The legend: the glyph and colour of each class, then each panel's share
+/// of samples per class (within / near / beyond, percent), or the time bands.
 pub fn legend(
     theme: &Theme,
     c: Colouring,
+    markers: &[Marker],
     panels: &[(String, Option<ClassCounts>)],
 ) -> Line<'static> {
     let mut spans = vec![Span::raw(" ")];
     if c == Colouring::Time {
         spans.push(Span::raw("time: earliest "));
-        for col in TIME_COLOURS {
-            spans.push(Span::styled("■", Style::default().fg(colour(theme, col))));
+        for (col, m) in TIME_COLOURS.iter().zip(markers) {
+            spans.push(Span::styled(
+                point_glyph(*m),
+                Style::default().fg(colour(theme, *col)),
+            ));
         }
         spans.push(Span::raw(" latest (sixths of the trial)"));
         return Line::from(spans);
     }
-    for class in LimitClass::ALL {
+    for (class, m) in LimitClass::ALL.into_iter().zip(markers) {
         spans.push(Span::styled(
-            "■",
+            point_glyph(*m),
             Style::default().fg(colour(theme, CLASS_COLOURS[class as usize])),
         ));
         spans.push(Span::raw(format!(" {}  ", class.label())));
@@ -82,7 +88,12 @@ pub fn legend_of(
             cor.map(|a| ClassCounts::of(a, range)),
         ),
     ];
-    legend(theme, c, &panels)
+    legend(
+        theme,
+        c,
+        &key_markers(app, theme, c == Colouring::Time),
+        &panels,
+    )
 }
 
 pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
@@ -119,7 +130,8 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
     }
     let bounds = axis_bounds(&sets, limits.as_ref().map(|l| &l.range_deg));
     let [left, right] = Layout::horizontal([Constraint::Ratio(1, 2); 2]).areas(grid);
-    let mk = marker(app);
+    let mk = marker(app, theme);
+    let keys = key_markers(app, theme, c == Colouring::Time);
     let colours: Vec<_> = match c {
         Colouring::Limits => CLASS_COLOURS.iter().map(|&k| colour(theme, k)).collect(),
         Colouring::Time => TIME_COLOURS.iter().map(|&k| colour(theme, k)).collect(),
@@ -168,10 +180,7 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
                     }
                     ctx.layer();
                     if let Some(r) = raster {
-                        ctx.draw(&RasterShape {
-                            raster: r,
-                            colours: &colours,
-                        });
+                        draw_keys(ctx, r, &colours, &keys, mk);
                     }
                 });
             f.render_widget(canvas, rows[p]);

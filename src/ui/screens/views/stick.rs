@@ -60,7 +60,7 @@ fn panel(f: &mut Frame, area: Rect, theme: &Theme, app: &Ctx, p: Panel) {
         project,
         reach,
     } = p;
-    let mk = marker(app);
+    let mk = marker(app, theme);
     let (bx, by) = square_bounds(area, mk, true, reach, reach);
     let lines: Vec<(f64, f64, f64, f64, Color)> = bones
         .iter()
