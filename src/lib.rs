@@ -13,6 +13,7 @@ pub mod baselines;
 pub mod calibration;
 pub mod correct;
 pub mod file_names;
+pub mod follow;
 pub mod ik;
 pub mod input;
 pub mod limits;

@@ -29,6 +29,7 @@ mod analysis;
 mod calibrate;
 mod common;
 mod correct;
+mod follow;
 mod plot;
 mod render;
 mod report;
@@ -77,6 +78,8 @@ pub struct Cli {
 pub enum Command {
     /// Correct a trial and write the corrected trial plus a sidecar JSON.
     Correct(correct::CorrectArgs),
+    /// Correct a trial while another program writes it: corrected rows as they land, then the final correction.
+    Follow(follow::FollowArgs),
     /// Print the figures (docs/method.md section 16) before and after each variant.
     Report(report::ReportArgs),
     /// Simulate a trial with known misalignment and drift, and write its truth beside it.
@@ -98,6 +101,7 @@ pub enum Command {
 pub fn run(cli: Cli) -> i32 {
     let result = match cli.command {
         Some(Command::Correct(a)) => correct::run(a),
+        Some(Command::Follow(a)) => follow::run(a),
         Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
         Some(Command::Render(a)) => render::run(a, &cli.theme),
