@@ -201,7 +201,10 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     let s = &ctx.settings;
     if !args.quiet {
         let warm = if args.warmup > 0.0 && args.warmup < s.window_s {
-            format!("every {} s until the first window is complete, then ", args.warmup)
+            format!(
+                "every {} s until the first window is complete, then ",
+                args.warmup
+            )
         } else {
             String::new()
         };
@@ -235,9 +238,8 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
             TailEvent::Lines { text, first_line } => {
                 let range = follower.push(&text, first_line)?;
                 if !range.is_empty() {
-                    let fmt = *format.get_or_insert_with(|| {
-                        follower.format().unwrap_or(TrialFormat::QuatCsv)
-                    });
+                    let fmt = *format
+                        .get_or_insert_with(|| follower.format().unwrap_or(TrialFormat::QuatCsv));
                     if let Some(batch) = follower.corrected(range) {
                         sink.write(&trial_to_string(&batch, fmt))?;
                     }

@@ -98,7 +98,10 @@ impl Solution {
                     }
                 }
                 let corrected = correction.corrected.imu(&raw.name);
-                match (raw.orientation.last(), corrected.and_then(|c| c.orientation.get(n - 1))) {
+                match (
+                    raw.orientation.last(),
+                    corrected.and_then(|c| c.orientation.get(n - 1)),
+                ) {
                     (Some(r), Some(c)) if r != c => ImuExtrapolation::Hold {
                         c: Quat::new_normalize((r.inverse() * c).into_inner()),
                     },

@@ -6,7 +6,9 @@ use crate::acm::RunControl;
 use crate::correct::pipeline::{self, Preparation, Setup};
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
-use crate::trial::{csv_format_of_header, read_rows_from_str, ImuSeries, Trial, TrialError, TrialFormat};
+use crate::trial::{
+    csv_format_of_header, read_rows_from_str, ImuSeries, Trial, TrialError, TrialFormat,
+};
 use crate::variant::Variant;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -190,7 +192,8 @@ impl Follower {
         if self.reached_until || rest.trim().is_empty() {
             return Ok(before..before);
         }
-        let mut batch = read_rows_from_str(&self.header, rest, line, &self.origin, &self.config.model)?;
+        let mut batch =
+            read_rows_from_str(&self.header, rest, line, &self.origin, &self.config.model)?;
         // The first data row's line, for an error about its time.
         let row_line = line
             + rest

@@ -83,10 +83,7 @@ mod tests {
             assert_eq!(s.last_reached(s.point(k)), Some(k));
             assert_eq!(s.last_reached(s.point(k) + 1e-6), Some(k));
         }
-        let none = Schedule {
-            warmup_s: 0.0,
-            ..s
-        };
+        let none = Schedule { warmup_s: 0.0, ..s };
         assert_eq!(none.point(0), 60.0);
         assert_eq!(none.last_reached(59.0), None);
         assert_eq!(none.last_reached(95.0), Some(1));

@@ -77,10 +77,7 @@ impl Tail {
                 return Ok(if self.offset == 0 {
                     TailEvent::Nothing
                 } else {
-                    self.restart(format!(
-                        "was removed after {} bytes were read",
-                        self.offset
-                    ))
+                    self.restart(format!("was removed after {} bytes were read", self.offset))
                 });
             }
             Err(e) => return Err(e),
@@ -208,7 +205,10 @@ mod tests {
         let TailEvent::Restarted { reason } = tail.poll().unwrap() else {
             panic!("rewrite not noticed");
         };
-        assert!(reason.contains("rewritten") || reason.contains("replaced"), "{reason}");
+        assert!(
+            reason.contains("rewritten") || reason.contains("replaced"),
+            "{reason}"
+        );
         assert_eq!(lines(tail.poll().unwrap()).0, "time,c_qw\n0,1\n1,1\n");
         // Replaced by a rename over it (another inode).
         let other = dir.path().join("u.csv");
