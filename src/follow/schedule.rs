@@ -40,7 +40,7 @@ impl Schedule {
     /// The index of the last point at or before `elapsed_s` (seconds from the
     /// first sample), if any.
     pub fn last_reached(&self, elapsed_s: f64) -> Option<usize> {
-        if !(elapsed_s >= self.point(0)) {
+        if elapsed_s.is_nan() || elapsed_s < self.point(0) {
             return None;
         }
         let w = self.warmups();
