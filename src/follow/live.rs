@@ -99,6 +99,10 @@ pub struct Follower {
     solution: Solution,
     generation: u64,
     reached_until: bool,
+    /// Samples of the newest solve asked for, and of the newest answered, in
+    /// this generation.
+    asked: usize,
+    answered: usize,
     requests: Option<mpsc::Sender<Request>>,
     answers: mpsc::Receiver<Answer>,
     cancel: Arc<AtomicBool>,
@@ -131,6 +135,8 @@ impl Follower {
             solution: Solution::identity(0),
             generation: 0,
             reached_until: false,
+            asked: 0,
+            answered: 0,
             requests: Some(requests),
             answers,
             cancel,
@@ -148,6 +154,8 @@ impl Follower {
         self.solution = Solution::identity(0);
         self.generation += 1;
         self.reached_until = false;
+        self.asked = 0;
+        self.answered = 0;
     }
 
     /// The rows read so far (`None` before the first).
@@ -251,6 +259,7 @@ impl Follower {
         }
         let prefix = prefix(trial, n);
         if let Some(tx) = &self.requests {
+            self.asked = n;
             let _ = tx.send(Request {
                 generation: self.generation,
                 point_s,
@@ -264,17 +273,28 @@ impl Follower {
     pub fn poll_solved(&mut self) -> Vec<Solved> {
         let mut out = Vec::new();
         while let Ok(a) = self.answers.try_recv() {
-            if a.generation != self.generation {
-                continue;
-            }
-            if let Some(s) = a.solution {
-                if s.samples >= self.solution.samples {
-                    self.solution = s;
-                }
-            }
-            out.push(a.solved);
+            self.take(a, &mut out);
         }
         out
+    }
+
+    fn take(&mut self, a: Answer, out: &mut Vec<Solved>) {
+        if a.generation != self.generation {
+            return;
+        }
+        // The solver skips requests that queued behind a newer one.
+        self.answered = self.answered.max(a.solved.samples);
+        if let Some(s) = a.solution {
+            if s.samples >= self.solution.samples {
+                self.solution = s;
+            }
+        }
+        out.push(a.solved);
+    }
+
+    /// Whether a solve asked for has not answered yet.
+    pub fn solving(&self) -> bool {
+        self.answered < self.asked
     }
 
     /// Waits up to `timeout` for the next solve to finish (then as [`Follower::poll_solved`]).
@@ -282,14 +302,7 @@ impl Follower {
         match self.answers.recv_timeout(timeout) {
             Ok(a) => {
                 let mut out = Vec::new();
-                if a.generation == self.generation {
-                    if let Some(s) = a.solution {
-                        if s.samples >= self.solution.samples {
-                            self.solution = s;
-                        }
-                    }
-                    out.push(a.solved);
-                }
+                self.take(a, &mut out);
                 out.extend(self.poll_solved());
                 out
             }
