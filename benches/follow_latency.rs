@@ -62,7 +62,14 @@ fn latency(trial: &Trial, seconds: f64, variant: &str) {
     file.flush().unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_acmw"))
         .current_dir(dir.path())
-        .args(["follow", "live.csv", "--idle-exit", "1", "--variant", variant])
+        .args([
+            "follow",
+            "live.csv",
+            "--idle-exit",
+            "1",
+            "--variant",
+            variant,
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -96,7 +103,11 @@ fn latency(trial: &Trial, seconds: f64, variant: &str) {
     }
     let seen = reader.join().unwrap();
     let out = child.wait_with_output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let mut ms: Vec<f64> = seen
         .iter()
         .zip(&written)
@@ -160,7 +171,12 @@ fn rms_table(trial: &Trial) {
         settings.window_s, settings.hop_s
     );
     let joints: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-    println!("variant (extrapolation)      mean  worst joint        {}", joints.join(" "));
+    println!(
+        "{:<30}  mean >{:.0}s  worst joint       {}",
+        "variant (extrapolation)",
+        settings.window_s,
+        joints.join(" ")
+    );
     let variants = [
         (Variant::Basic, Extrapolation::Hold),
         (Variant::Drift, Extrapolation::Hold),
@@ -175,7 +191,8 @@ fn rms_table(trial: &Trial) {
     ];
     for (variant, how) in variants {
         let prepared = pipeline::prepare(trial.clone(), setup, &Preparation::default()).unwrap();
-        let fin = pipeline::correct(&prepared.trial, setup, variant, &RunControl::default()).unwrap();
+        let fin =
+            pipeline::correct(&prepared.trial, setup, variant, &RunControl::default()).unwrap();
         let live = live(
             trial,
             FollowerConfig {
@@ -189,31 +206,36 @@ fn rms_table(trial: &Trial) {
                 until_s: None,
             },
         );
+        // Samples from the first window's end on (what is left once warmed up).
+        let t0 = trial.time_s[0];
+        let warm = trial
+            .time_s
+            .partition_point(|&t| t - t0 < settings.window_s);
         let mut per_joint = Vec::new();
+        let mut after = Vec::new();
         for j in &model.joints {
-            let (Some(a), Some(b)) = (joint_angles(&live, j), joint_angles(&fin.corrected, j)) else {
+            let (Some(a), Some(b)) = (joint_angles(&live, j), joint_angles(&fin.corrected, j))
+            else {
                 continue;
             };
-            let sum: f64 = a
-                .iter()
-                .zip(&b)
-                .map(|(x, y)| (0..3).map(|k| wrap180(x[k] - y[k]).powi(2)).sum::<f64>())
-                .sum();
-            per_joint.push((j.name.clone(), (sum / (3 * a.len()) as f64).sqrt()));
+            let rms = |from: usize| {
+                let sum: f64 = a[from..]
+                    .iter()
+                    .zip(&b[from..])
+                    .map(|(x, y)| (0..3).map(|k| wrap180(x[k] - y[k]).powi(2)).sum::<f64>())
+                    .sum();
+                (sum / (3 * (a.len() - from)) as f64).sqrt()
+            };
+            per_joint.push((j.name.clone(), rms(0)));
+            after.push(rms(warm));
         }
         let mean = per_joint.iter().map(|p| p.1).sum::<f64>() / per_joint.len() as f64;
-        let worst = per_joint
-            .iter()
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .unwrap();
-        let label = format!(
-            "{} ({})",
-            variant,
-            acm_workbench::names::Named::name(how)
-        );
+        let mean_after = after.iter().sum::<f64>() / after.len() as f64;
+        let worst = per_joint.iter().max_by(|a, b| a.1.total_cmp(&b.1)).unwrap();
+        let label = format!("{} ({})", variant, acm_workbench::names::Named::name(how));
         let cells: Vec<String> = per_joint.iter().map(|p| format!("{:.2}", p.1)).collect();
         println!(
-            "{label:<28} {mean:5.2}  {:<10} {:5.2}  {}",
+            "{label:<30} {mean:5.2} {mean_after:5.2}  {:<10} {:5.2}  {}",
             worst.0,
             worst.1,
             cells.join(" ")
