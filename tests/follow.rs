@@ -269,3 +269,18 @@ fn until_stops_at_the_trial_time_and_corrects_the_rows_read() {
     let live = read_trial(&dir.path().join("stream.csv"), &model()).unwrap();
     assert_eq!(live.time_s, fin.time_s);
 }
+
+#[test]
+fn a_malformed_row_is_located_and_exits_3() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("growing.csv");
+    let trial = drifting(2.0, 9);
+    let text = trial_to_string(&trial, TrialFormat::QuatCsv);
+    let mut lines: Vec<&str> = text.lines().take(4).collect();
+    lines.push("0.08,1,0,0");
+    std::fs::write(&input, lines.join("\n") + "\n").unwrap();
+    let out = follow(dir.path(), &input, &[]).wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("growing.csv:5:"), "{stderr}");
+}

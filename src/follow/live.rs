@@ -409,3 +409,74 @@ fn solver(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trial::{read_trial_from_str, trial_to_string};
+
+    fn config(until_s: Option<f64>) -> FollowerConfig {
+        FollowerConfig {
+            model: Model::infant13(),
+            limits: LimitTable::default_table(),
+            limits_source: "<built-in>".into(),
+            settings: Settings::default(),
+            variant: Variant::DriftCentroid,
+            extrapolation: Extrapolation::default(),
+            warmup_s: 0.0,
+            until_s,
+        }
+    }
+
+    #[test]
+    fn rows_pushed_in_any_batches_are_the_trial_the_file_reader_reads() {
+        let sim = crate::simulate::simulate(&crate::simulate::SimConfig {
+            duration_s: 6.0,
+            ..crate::simulate::SimConfig::full_body(3)
+        })
+        .unwrap();
+        let text = format!(
+            "# a comment\n\n{}",
+            trial_to_string(&sim.trial, TrialFormat::EulerCsv)
+        );
+        let whole =
+            read_trial_from_str(&text, "x.csv", TrialFormat::EulerCsv, &Model::infant13()).unwrap();
+        let lines: Vec<&str> = text.split_inclusive('\n').collect();
+        let mut f = Follower::new("x.csv", config(None));
+        let (mut at, mut k) = (0, 1usize);
+        while at < lines.len() {
+            let n = (k % 7 + 1).min(lines.len() - at);
+            f.push(&lines[at..at + n].concat(), at as u64 + 1).unwrap();
+            at += n;
+            k += 3;
+        }
+        assert_eq!(f.format(), Some(TrialFormat::EulerCsv));
+        let got = f.trial().unwrap();
+        assert_eq!(got.time_s, whole.time_s);
+        assert_eq!(got.imus, whole.imus);
+        // Before any solve the rows pass through unchanged.
+        let c = f.corrected(0..got.len()).unwrap();
+        assert_eq!(c.imus, whole.imus);
+        // A bad row and a time going back are located at their lines.
+        let last = *whole.time_s.last().unwrap();
+        let n = lines.len() as u64;
+        let e = f.push("1e9,oops\n", n + 1).unwrap_err().to_string();
+        assert!(e.starts_with(&format!("x.csv:{}:", n + 1)), "{e}");
+        let row = lines[lines.len() - 1].replacen(&format!("{last}"), "0.5", 1);
+        let e = f.push(&format!("\n{row}"), n + 1).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("x.csv:{}:1:", n + 2)) && e.contains("strictly increase"),
+            "{e}"
+        );
+        // --until keeps the rows up to its time.
+        let mut f = Follower::new("x.csv", config(Some(2.0)));
+        f.push(&text, 1).unwrap();
+        assert!(f.reached_until());
+        let t = &f.trial().unwrap().time_s;
+        assert!(
+            *t.last().unwrap() - t[0] <= 2.0 + 1e-9 && t.len() == 101,
+            "{}",
+            t.len()
+        );
+    }
+}
