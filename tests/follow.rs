@@ -284,3 +284,49 @@ fn a_malformed_row_is_located_and_exits_3() {
     assert_eq!(out.status.code(), Some(3), "{stderr}");
     assert!(stderr.contains("growing.csv:5:"), "{stderr}");
 }
+
+#[cfg(unix)]
+#[test]
+fn a_termination_signal_ends_following_with_the_final_correction() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("growing.csv");
+    let trial = drifting(40.0, 10);
+    std::fs::write(&input, trial_to_string(&trial, TrialFormat::QuatCsv)).unwrap();
+    let child = acmw()
+        .current_dir(dir.path())
+        .arg("follow")
+        .arg(&input)
+        .args([
+            "-o",
+            "stream.csv",
+            "--corrected",
+            "final.csv",
+            "--window",
+            "30",
+            "--hop",
+            "15",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until every row was streamed, then stop it as Ctrl-C would.
+    let stream = dir.path().join("stream.csv");
+    let start = Instant::now();
+    while std::fs::read_to_string(&stream).map_or(0, |s| s.lines().count()) < trial.len() + 1 {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "rows never streamed"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // SAFETY: kill(2) on the child's pid, which has not been reaped.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+    let (_, stderr) = finish(child);
+    assert!(
+        stderr.contains("interrupted; writing the final correction"),
+        "{stderr}"
+    );
+    let (offline, _) = correct(dir.path(), &input);
+    assert!(std::fs::read(dir.path().join("final.csv")).unwrap() == offline);
+}
