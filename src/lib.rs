@@ -14,6 +14,7 @@ pub mod batch;
 pub mod calibration;
 pub mod correct;
 pub mod file_names;
+pub mod follow;
 pub mod ik;
 pub mod input;
 pub mod limits;

@@ -30,6 +30,7 @@ mod batch;
 mod calibrate;
 mod common;
 mod correct;
+mod follow;
 mod plot;
 mod render;
 mod report;
@@ -89,6 +90,8 @@ pub enum Command {
     /// Correct every trial of folders or patterns into one folder, with a
     /// resumable manifest; shards for clusters.
     Batch(batch::BatchArgs),
+    /// Correct a trial while another program writes it: corrected rows as they land, then the final correction.
+    Follow(follow::FollowArgs),
     /// Print the figures (docs/method.md section 16) before and after each variant.
     Report(report::ReportArgs),
     /// Simulate a trial with known misalignment and drift, and write its truth beside it.
@@ -111,6 +114,7 @@ pub fn run(cli: Cli) -> i32 {
     let result = match cli.command {
         Some(Command::Correct(a)) => correct::run(a),
         Some(Command::Batch(a)) => batch::run(a),
+        Some(Command::Follow(a)) => follow::run(a),
         Some(Command::Report(a)) => report::run(a),
         Some(Command::Simulate(a)) => simulate::run(a),
         Some(Command::Render(a)) => render::run(a, &cli.theme, cli.ascii),

@@ -317,6 +317,38 @@ pub fn read_trial_from_str(
     parse_trial(text, origin, &name_of(origin), format, model)
 }
 
+/// Reads the data rows `rows` of a canonical or Euler CSV whose header (any
+/// `#` comment lines and the column header) is `header`, as [`read_trial`]
+/// reads them: the same columns, numbers and errors. `first_line` is the
+/// 1-based line of the file `rows` starts at, for located errors. Times must
+/// increase within `rows`; the checks of a whole trial's time axis (rate,
+/// span) are left to the caller, who sees the rows before and after.
+/// `rows` must hold at least one data row.
+pub fn read_rows_from_str(
+    header: &str,
+    rows: &str,
+    first_line: u64,
+    origin: &str,
+    model: &Model,
+) -> Result<Trial, TrialError> {
+    let format = first_header(header).map_or(TrialFormat::QuatCsv, classify_csv_header);
+    let layout = parse_header(&mut LineIter::new(header), origin, format, model)?;
+    parse::parse_rows(
+        LineIter::starting_at(rows, first_line),
+        layout,
+        origin,
+        &name_of(origin),
+        format,
+        false,
+    )
+}
+
+/// The format of a CSV trial from its header line: canonical (`<imu>_qw`...)
+/// or Euler (`<imu>_roll`...).
+pub fn csv_format_of_header(header_line: &str) -> TrialFormat {
+    classify_csv_header(header_line)
+}
+
 /// Reads only the header of a trial file: format, compression and IMU names.
 /// The header is checked as [`read_trial`] would check it.
 pub fn read_trial_header(path: &Path, model: &Model) -> Result<TrialHeader, TrialError> {

@@ -31,6 +31,14 @@ impl<'a> LineIter<'a> {
         }
     }
 
+    /// Lines of a part of a file whose first line is line `first` (1-based).
+    pub(crate) fn starting_at(text: &'a str, first: u64) -> Self {
+        LineIter {
+            rest: Some(text),
+            line_no: first.saturating_sub(1),
+        }
+    }
+
     /// Number of the last line returned (0 before the first).
     pub(crate) fn line_no(&self) -> u64 {
         self.line_no
@@ -615,7 +623,13 @@ impl<'a> Acc<'a> {
         Ok(())
     }
 
-    fn finish(self, name: &str, layout: Layout, end_line: u64) -> Result<Trial, TrialError> {
+    fn finish(
+        self,
+        name: &str,
+        layout: Layout,
+        end_line: u64,
+        check_axis: bool,
+    ) -> Result<Trial, TrialError> {
         if self.time.is_empty() {
             return Err(TrialError::at(
                 self.origin,
@@ -627,7 +641,12 @@ impl<'a> Acc<'a> {
                 ),
             ));
         }
-        if let Err((i, message)) = crate::trial::timing::check_time_axis(&self.time) {
+        let axis = if check_axis {
+            crate::trial::timing::check_time_axis(&self.time)
+        } else {
+            Ok(())
+        };
+        if let Err((i, message)) = axis {
             let line = if i == 0 { self.lines[0] } else { self.lines[i] };
             return Err(TrialError::at(self.origin, line, 1, message));
         }
@@ -729,6 +748,21 @@ pub(crate) fn parse_trial(
     }
     let mut lines = LineIter::new(text);
     let layout = parse_header(&mut lines, origin, format, model)?;
+    parse_rows(lines, layout, origin, name, format, true)
+}
+
+/// Reads the data rows that follow a parsed header: `lines` continues after
+/// the header (its line numbers are the file's). `check_axis`: check the
+/// times as a whole trial's ([`crate::trial::timing::check_time_axis`]);
+/// without it the rows are only checked to increase.
+pub(crate) fn parse_rows(
+    mut lines: LineIter<'_>,
+    layout: Layout,
+    origin: &str,
+    name: &str,
+    format: TrialFormat,
+    check_axis: bool,
+) -> Result<Trial, TrialError> {
     let mut acc = Acc::new(origin, layout.imus.len());
     let ncols = layout.columns.len();
     match format {
@@ -809,5 +843,5 @@ pub(crate) fn parse_trial(
         }
     }
     let end = lines.line_no() + 1;
-    acc.finish(name, layout, end)
+    acc.finish(name, layout, end, check_axis)
 }

@@ -1,0 +1,28 @@
+//! Following a trial while another program is still writing it: the core of
+//! `acmw follow`, with nothing of the terminal or the command line.
+//!
+//! * [`tail`] reads what was appended to a canonical or Euler CSV since the
+//!   last look, complete lines only, and notices when the file was
+//!   truncated or replaced;
+//! * [`schedule`] says when the growing trial is solved again: while the
+//!   first drift window fills, every few seconds of trial time; then each
+//!   time a window `[k * hop, k * hop + window)` is complete;
+//! * [`extrapolate`] turns the correction of the samples so far into one for
+//!   samples past its end (the last correction held, or for the heading
+//!   variants the heading drift continued at its last rate);
+//! * [`live`] keeps the rows read, solves the prefixes in a background
+//!   thread through the one pipeline ([`crate::correct::pipeline`]) and
+//!   corrects each new row with the newest solution.
+//!
+//! The final, offline-quality correction is the pipeline's own, run on the
+//! whole trial once it stops growing.
+
+pub mod extrapolate;
+pub mod live;
+pub mod schedule;
+pub mod tail;
+
+pub use extrapolate::{Extrapolation, ImuExtrapolation, Solution};
+pub use live::{Follower, FollowerConfig, Solved};
+pub use schedule::Schedule;
+pub use tail::{Tail, TailEvent};

@@ -1,0 +1,332 @@
+//! `acmw follow` through the binary: a writer appends a simulated drifting
+//! trial in random fragments (cut anywhere, mid-number included) while the
+//! follower reads it. The final correction must equal `acmw correct` of the
+//! whole file byte for byte, the live stream must hold every row exactly
+//! once with the uncorrected IMU's columns exactly as written (a row read
+//! half-written would show a cut number), and a truncated file must be
+//! noticed and followed from its new start.
+
+use acm_workbench::simulate::{simulate, HeadingDrift, SimConfig};
+use acm_workbench::trial::{read_trial, trial_to_string, Trial, TrialFormat};
+use rand::{Rng, SeedableRng};
+use std::io::Write;
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn acmw() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_acmw"))
+}
+
+/// A drifting 13-IMU trial of `seconds` at 50 Hz.
+fn drifting(seconds: f64, seed: u64) -> Trial {
+    let config = SimConfig {
+        duration_s: seconds,
+        drifts: vec![
+            HeadingDrift {
+                imu: "l_calf".into(),
+                start_s: 20.0,
+                rate_deg_s: 0.1,
+            },
+            HeadingDrift {
+                imu: "r_upper_arm".into(),
+                start_s: 10.0,
+                rate_deg_s: 0.15,
+            },
+        ],
+        ..SimConfig::full_body(seed)
+    };
+    simulate(&config).unwrap().trial
+}
+
+/// Appends `text` to `path` in random fragments of 1..=4000 bytes, flushed
+/// each, over about `seconds` of wall-clock time.
+fn write_in_fragments(path: &Path, text: &[u8], seconds: f64, seed: u64) {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut f = std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+        .unwrap();
+    let per_byte = seconds / text.len() as f64;
+    let mut pos = 0;
+    while pos < text.len() {
+        let n = rng.random_range(1..=4000).min(text.len() - pos);
+        f.write_all(&text[pos..pos + n]).unwrap();
+        f.flush().unwrap();
+        pos += n;
+        std::thread::sleep(Duration::from_secs_f64(n as f64 * per_byte));
+    }
+}
+
+fn follow(dir: &Path, input: &Path, extra: &[&str]) -> Child {
+    acmw()
+        .current_dir(dir)
+        .arg("follow")
+        .arg(input)
+        .args([
+            "-o",
+            "stream.csv",
+            "--corrected",
+            "final.csv",
+            "--sidecar",
+            "final.json",
+        ])
+        .args([
+            "--idle-exit",
+            "2",
+            "--window",
+            "30",
+            "--hop",
+            "15",
+            "--warmup",
+            "5",
+        ])
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn finish(child: Child) -> (String, String) {
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "acmw follow failed: {stderr}");
+    (String::from_utf8_lossy(&out.stdout).into_owned(), stderr)
+}
+
+/// `acmw correct` of `input` with the settings the follower used.
+fn correct(dir: &Path, input: &Path) -> (Vec<u8>, serde_json::Value) {
+    let out = acmw()
+        .current_dir(dir)
+        .arg("correct")
+        .arg(input)
+        .args(["-o", "offline.csv", "--sidecar", "offline.json", "-q"])
+        .args(["--window", "30", "--hop", "15"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (
+        std::fs::read(dir.join("offline.csv")).unwrap(),
+        sidecar(&dir.join("offline.json")),
+    )
+}
+
+/// A sidecar without the output's name (the one thing that differs).
+fn sidecar(path: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    v.as_object_mut().unwrap().remove("output");
+    v
+}
+
+fn model() -> acm_workbench::model::Model {
+    acm_workbench::model::Model::infant13()
+}
+
+/// Every row once, in order, at the input's times; the uncorrected base IMU
+/// exactly as written (canonical sign), so no row was read half-written.
+fn check_stream(stream: &Path, input: &Trial, format: TrialFormat) {
+    let live = read_trial(stream, &model()).unwrap();
+    assert_eq!(live.time_s, input.time_s, "the stream has every row once");
+    let base_in = &input.imus[0];
+    let base_out = live.imu(&base_in.name).unwrap();
+    assert_eq!(base_in.name, "base");
+    // The stream's rows, as text, against the input's written the same way.
+    let expect = trial_to_string(input, format);
+    let got = std::fs::read_to_string(stream).unwrap();
+    let column = |text: &str, k: usize| -> Vec<String> {
+        text.lines()
+            .map(|l| l.split(',').take(k).collect::<Vec<_>>().join(","))
+            .collect()
+    };
+    let k = if format == TrialFormat::EulerCsv {
+        4
+    } else {
+        5
+    };
+    assert_eq!(column(&got, k), column(&expect, k), "time and base columns");
+    assert_eq!(base_out.orientation.len(), base_in.orientation.len());
+}
+
+#[test]
+fn final_output_equals_correct_and_the_stream_has_every_row_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("growing.csv");
+    let trial = drifting(150.0, 5);
+    let text = trial_to_string(&trial, TrialFormat::QuatCsv);
+    let child = follow(dir.path(), &input, &[]);
+    // 150 s of trial written in about 8 s (x19), cut anywhere.
+    write_in_fragments(&input, text.as_bytes(), 8.0, 1);
+    let (_, stderr) = finish(child);
+    assert!(
+        stderr.contains("solved 0-5.0 s") || stderr.contains("solved 0-"),
+        "{stderr}"
+    );
+    let (offline, offline_sidecar) = correct(dir.path(), &input);
+    let fin = std::fs::read(dir.path().join("final.csv")).unwrap();
+    assert!(
+        fin == offline,
+        "the final correction differs from acmw correct"
+    );
+    assert_eq!(sidecar(&dir.path().join("final.json")), offline_sidecar);
+    let written = read_trial(&input, &model()).unwrap();
+    check_stream(
+        &dir.path().join("stream.csv"),
+        &written,
+        TrialFormat::QuatCsv,
+    );
+    // The live rows were corrected: past the first solve they are not the raw ones.
+    let live = read_trial(&dir.path().join("stream.csv"), &model()).unwrap();
+    let calf = (live.imu("l_calf").unwrap(), written.imu("l_calf").unwrap());
+    let last = live.len() - 1;
+    assert!(
+        acm_workbench::rotation::angle_between_deg(
+            &calf.0.orientation[last],
+            &calf.1.orientation[last]
+        ) > 1.0,
+        "the last live row was not corrected"
+    );
+}
+
+#[test]
+fn truncation_is_noticed_and_an_euler_trial_followed_from_its_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("growing.csv");
+    let first = trial_to_string(&drifting(40.0, 6), TrialFormat::QuatCsv);
+    let second_trial = drifting(60.0, 7);
+    let second = trial_to_string(&second_trial, TrialFormat::EulerCsv);
+    let child = follow(dir.path(), &input, &["--format", "euler-csv"]);
+    write_in_fragments(&input, &first.as_bytes()[..first.len() * 2 / 3], 2.0, 2);
+    std::thread::sleep(Duration::from_millis(800));
+    // The writer starts again: the file is truncated and a new trial written.
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&input)
+        .unwrap()
+        .set_len(0)
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    write_in_fragments(&input, second.as_bytes(), 3.0, 3);
+    let (_, stderr) = finish(child);
+    assert!(
+        // Truncated (or, should the follower look only once the new trial
+        // outgrew the old, rewritten): either way it starts over.
+        (stderr.contains("was truncated") || stderr.contains("was rewritten"))
+            && stderr.contains("starting over"),
+        "{stderr}"
+    );
+    let written = read_trial(&input, &model()).unwrap();
+    let out = acmw()
+        .current_dir(dir.path())
+        .arg("correct")
+        .arg(&input)
+        .args([
+            "-o",
+            "offline.csv",
+            "-q",
+            "--window",
+            "30",
+            "--hop",
+            "15",
+            "--format",
+            "euler-csv",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert_eq!(
+        std::fs::read(dir.path().join("final.csv")).unwrap(),
+        std::fs::read(dir.path().join("offline.csv")).unwrap()
+    );
+    check_stream(
+        &dir.path().join("stream.csv"),
+        &written,
+        TrialFormat::EulerCsv,
+    );
+}
+
+#[test]
+fn until_stops_at_the_trial_time_and_corrects_the_rows_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("growing.csv");
+    let trial = drifting(50.0, 8);
+    std::fs::write(&input, trial_to_string(&trial, TrialFormat::QuatCsv)).unwrap();
+    let start = Instant::now();
+    let (_, stderr) = finish(follow(dir.path(), &input, &["--until", "35"]));
+    assert!(start.elapsed() < Duration::from_secs(60));
+    assert!(stderr.contains("continues past --until"), "{stderr}");
+    let fin = read_trial(&dir.path().join("final.csv"), &model()).unwrap();
+    let want = trial
+        .time_s
+        .partition_point(|&t| t - trial.time_s[0] <= 35.0 + 1e-9);
+    assert_eq!(fin.len(), want);
+    let live = read_trial(&dir.path().join("stream.csv"), &model()).unwrap();
+    assert_eq!(live.time_s, fin.time_s);
+}
+
+#[test]
+fn a_malformed_row_is_located_and_exits_3() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("growing.csv");
+    let trial = drifting(2.0, 9);
+    let text = trial_to_string(&trial, TrialFormat::QuatCsv);
+    let mut lines: Vec<&str> = text.lines().take(4).collect();
+    lines.push("0.08,1,0,0");
+    std::fs::write(&input, lines.join("\n") + "\n").unwrap();
+    let out = follow(dir.path(), &input, &[]).wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("growing.csv:5:"), "{stderr}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_termination_signal_ends_following_with_the_final_correction() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("growing.csv");
+    let trial = drifting(40.0, 10);
+    std::fs::write(&input, trial_to_string(&trial, TrialFormat::QuatCsv)).unwrap();
+    let child = acmw()
+        .current_dir(dir.path())
+        .arg("follow")
+        .arg(&input)
+        .args([
+            "-o",
+            "stream.csv",
+            "--corrected",
+            "final.csv",
+            "--window",
+            "30",
+            "--hop",
+            "15",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until every row was streamed, then stop it as Ctrl-C would.
+    let stream = dir.path().join("stream.csv");
+    let start = Instant::now();
+    while std::fs::read_to_string(&stream).map_or(0, |s| s.lines().count()) < trial.len() + 1 {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "rows never streamed"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // SAFETY: kill(2) on the child's pid, which has not been reaped.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+    let (_, stderr) = finish(child);
+    assert!(
+        stderr.contains("interrupted; writing the final correction"),
+        "{stderr}"
+    );
+    let (offline, _) = correct(dir.path(), &input);
+    assert!(std::fs::read(dir.path().join("final.csv")).unwrap() == offline);
+}
