@@ -35,6 +35,13 @@ pub fn stem_without(path: &Path, suffixes: &[&str]) -> String {
     name[..stem_len].to_string()
 }
 
+/// True when `path`'s name could be an OpenSense mapping: it ends in `.xml`
+/// (any case). Its content decides whether it is one.
+pub fn is_mapping_name(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
 /// True when `path`'s name is a functional calibration recording:
 /// `*.calib.csv`, optionally `.gz` (any case). Such files are never trials.
 pub fn is_calibration_recording(path: &Path) -> bool {
@@ -68,5 +75,12 @@ mod tests {
         assert!(is_calibration_recording(Path::new("W.CALIB.CSV")));
         assert!(!is_calibration_recording(Path::new(".calib.csv")));
         assert!(!is_calibration_recording(Path::new("walk.csv")));
+    }
+
+    #[test]
+    fn mapping_names_end_in_xml() {
+        assert!(is_mapping_name(Path::new("d/Walk.XML")));
+        assert!(!is_mapping_name(Path::new("walk.xml.csv")));
+        assert!(!is_mapping_name(Path::new("xml")));
     }
 }

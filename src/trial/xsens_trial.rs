@@ -35,9 +35,7 @@ fn read_text(path: &Path) -> Result<String, TrialError> {
 
 /// True when `path` is an XML file holding an OpenSense Xsens mapping.
 pub fn is_mapping_file(path: &Path) -> bool {
-    let xml = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+    let xml = crate::file_names::is_mapping_name(path);
     xml && path.is_file() && head(path, 1 << 16).is_some_and(|t| looks_like_mapping(&t))
 }
 

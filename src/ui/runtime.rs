@@ -13,7 +13,7 @@ use crate::trial::{is_trial_file, is_trial_path};
 
 /// An `.xml` name (a mapping that may just have been removed).
 fn is_xml(p: &Path) -> bool {
-    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+    crate::file_names::is_mapping_name(p)
 }
 use crossbeam_channel::{unbounded, Receiver, Sender};
 use notify::RecursiveMode;
