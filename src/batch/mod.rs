@@ -17,7 +17,6 @@ use crate::input::sha256_hex;
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
 use crate::sidecar::sidecar_path;
-use crate::trial::xsens_trial::{is_mapping_file, resolve};
 use crate::trial::{detect_format, detect_model, input_bytes, is_trial_path, TrialFormat};
 use crate::variant::Variant;
 use manifest::{Manifest, Row, Status};
@@ -147,29 +146,10 @@ pub fn discover(inputs: &[String]) -> Result<Vec<PathBuf>, BatchError> {
 
 /// The trials in folder `dir` (not recursive), as the workbench lists them.
 fn folder_trials(dir: &Path) -> Result<Vec<PathBuf>, BatchError> {
-    let rd = std::fs::read_dir(dir).map_err(|e| BatchError::List {
+    crate::trial::folder_trials(dir).map_err(|e| BatchError::List {
         path: dir.display().to_string(),
         message: e.to_string(),
-    })?;
-    let paths: Vec<PathBuf> = rd
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| is_trial_path(p))
-        .collect();
-    let read_by_mapping: Vec<PathBuf> = paths
-        .iter()
-        .filter(|p| p.is_file() && is_mapping_file(p))
-        .filter_map(|xml| resolve(xml).ok())
-        .flat_map(|s| {
-            s.files
-                .into_iter()
-                .filter_map(|(f, _)| f.parent().map(Path::to_path_buf))
-        })
-        .collect();
-    Ok(paths
-        .into_iter()
-        .filter(|p| !(p.is_dir() && read_by_mapping.contains(p)))
-        .collect())
+    })
 }
 
 /// What a batch does to every trial, and where it writes.

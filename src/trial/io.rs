@@ -26,7 +26,7 @@ use crate::model::Model;
 use crate::rotation::{canonical, euler_zyx_deg};
 use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Read, Write as _};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 #[cfg(test)]
 mod gyro_tests;
@@ -115,6 +115,32 @@ pub fn is_trial_path(path: &Path) -> bool {
     } else {
         is_trial_file(path) || is_mapping_file(path) || is_export_file(path)
     }
+}
+
+/// The trials in folder `dir` (not recursive), in no particular order: trial
+/// files, OpenSense mapping XMLs, and folders of Xsens exports that no listed
+/// mapping reads (a mapping's folder is its trial, not a second one).
+pub fn folder_trials(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    use super::xsens_trial::{is_mapping_file, resolve};
+    let paths: Vec<PathBuf> = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| is_trial_path(p))
+        .collect();
+    let read_by_mapping: Vec<PathBuf> = paths
+        .iter()
+        .filter(|p| p.is_file() && is_mapping_file(p))
+        .filter_map(|xml| resolve(xml).ok())
+        .flat_map(|s| {
+            s.files
+                .into_iter()
+                .filter_map(|(f, _)| f.parent().map(Path::to_path_buf))
+        })
+        .collect();
+    Ok(paths
+        .into_iter()
+        .filter(|p| !(p.is_dir() && read_by_mapping.contains(p)))
+        .collect())
 }
 
 /// The bytes that identify a trial's input for the sidecar's hash: the file, or

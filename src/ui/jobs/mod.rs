@@ -17,8 +17,7 @@ use crate::model::Model;
 use crate::sidecar::default_output;
 use crate::simulate::truth::load_truth_beside;
 use crate::trial::glitch::glitches;
-use crate::trial::xsens_trial::{is_mapping_file, resolve};
-use crate::trial::{detect_format, detect_model, is_trial_path, read_trial, TrialError};
+use crate::trial::{detect_format, detect_model, read_trial, TrialError};
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -27,25 +26,9 @@ use std::sync::Arc;
 /// Trial names in `dir` (non-recursive), sorted: trial files, OpenSense
 /// mapping XMLs, and folders of Xsens exports that no listed mapping reads.
 pub fn list_trials(dir: &Path) -> Result<Vec<String>, String> {
-    let rd = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let paths: Vec<PathBuf> = rd
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| is_trial_path(p))
-        .collect();
-    let read_by_mapping: Vec<PathBuf> = paths
-        .iter()
-        .filter(|p| p.is_file() && is_mapping_file(p))
-        .filter_map(|xml| resolve(xml).ok())
-        .flat_map(|s| {
-            s.files
-                .into_iter()
-                .filter_map(|(f, _)| f.parent().map(Path::to_path_buf))
-        })
-        .collect();
+    let paths = crate::trial::folder_trials(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut names: Vec<String> = paths
         .iter()
-        .filter(|p| !(p.is_dir() && read_by_mapping.contains(p)))
         .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
     names.sort();
