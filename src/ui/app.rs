@@ -452,24 +452,13 @@ pub fn wants_ticks(app: &App) -> bool {
 fn action(app: &mut App, a: Action) -> Vec<Effect> {
     // Overlays answer first.
     match (&app.overlay, a) {
-        (
-            Some(Overlay::Help),
-            Action::Up
-            | Action::Down
-            | Action::PageUp
-            | Action::PageDown
-            | Action::Home
-            | Action::End,
-        ) => {
-            let (at, max) = (app.help_scroll.min(app.help_max.get()), app.help_max.get());
-            app.help_scroll = match a {
-                Action::Up => at.saturating_sub(1),
-                Action::Down => (at + 1).min(max),
-                Action::PageUp => at.saturating_sub(10),
-                Action::PageDown => (at + 10).min(max),
-                Action::Home => 0,
-                _ => max,
-            };
+        (Some(Overlay::Help), a) if a.moves_in_list() => {
+            // The help scrolls as a list of help_max + 1 first lines.
+            let max = app.help_max.get();
+            let at = app.help_scroll.min(max);
+            if let Some(to) = crate::ui::cells::list_move(a, at, max + 1, 10) {
+                app.help_scroll = to;
+            }
             return vec![];
         }
         (Some(Overlay::Help), _) => {

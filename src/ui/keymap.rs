@@ -48,6 +48,22 @@ pub enum Action {
     Mouse,
 }
 
+impl Action {
+    /// Moves a list's selection (Up/Down, PgUp/PgDn, Home/End): what
+    /// [`crate::ui::cells::list_move`] answers.
+    pub fn moves_in_list(self) -> bool {
+        matches!(
+            self,
+            Action::Up
+                | Action::Down
+                | Action::PageUp
+                | Action::PageDown
+                | Action::Home
+                | Action::End
+        )
+    }
+}
+
 /// Where a binding applies, for the help overlay.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Scope {

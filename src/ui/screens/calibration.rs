@@ -44,12 +44,7 @@ pub fn action(c: &mut CalibState, app: &mut Workbench, a: Action) -> Reply {
     let n = c.entries.len();
     match a {
         Action::Back => return Reply::nav(Nav::To(Screen::Trials)),
-        Action::Up
-        | Action::Down
-        | Action::PageUp
-        | Action::PageDown
-        | Action::Home
-        | Action::End => {
+        a if a.moves_in_list() => {
             if let Some(i) = crate::ui::cells::list_move(a, c.selected, n, 10) {
                 c.selected = i;
             }

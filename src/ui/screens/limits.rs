@@ -216,12 +216,7 @@ pub fn action(app: &mut Workbench, from: Screen, a: Action) -> Reply {
     let n = l.rows();
     match a {
         Action::Back => return Reply::nav(Nav::To(from)),
-        Action::Up
-        | Action::Down
-        | Action::PageUp
-        | Action::PageDown
-        | Action::Home
-        | Action::End => {
+        a if a.moves_in_list() => {
             if let Some(i) = list_move(a, l.row, n, 10) {
                 l.row = i;
             }

@@ -210,12 +210,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
 pub fn action(app: &mut Workbench, a: Action) -> Reply {
     let n = app.visible().len();
     match a {
-        Action::Up
-        | Action::Down
-        | Action::PageUp
-        | Action::PageDown
-        | Action::Home
-        | Action::End => {
+        a if a.moves_in_list() => {
             if let Some(i) = list_move(a, app.selected, n, 10) {
                 app.selected = i;
             }
