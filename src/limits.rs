@@ -164,7 +164,7 @@ impl SettingsFile {
         let s: SettingsFile = toml::from_str(text).map_err(|e| {
             let (line, column) = e
                 .span()
-                .map(|sp| line_col(text, sp.start))
+                .map(|sp| crate::input::line_col(text, sp.start))
                 .unwrap_or((0, 0));
             LimitsError {
                 file: origin.into(),
@@ -276,13 +276,6 @@ impl LimitsDir {
             table_source,
         })
     }
-}
-
-fn line_col(text: &str, offset: usize) -> (u64, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() as u64 + 1;
-    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, col)
 }
 
 /// A setting out of bounds: which key, and what was expected and found.
