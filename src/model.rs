@@ -184,29 +184,66 @@ fn is_all_axes(v: &[Axis]) -> bool {
 pub enum Hinge {
     /// One axis, fixed in both segments (`"y"` for a knee: flexion only).
     Single(Axis),
-    /// Two axes: Z fixed in the proximal segment and X in the distal one, the
-    /// Y angle constant (`"z-x"` for an elbow: pronation and flexion).
-    ZX,
+    /// Two segment axes, the third Z-Y-X angle constant: `proximal`, the
+    /// earlier of the two in Z-Y-X order, is fixed in the proximal segment and
+    /// `distal` in the distal one (`"z-x"` for the elbow of frames whose
+    /// carrying angle is Y: pronation and flexion; `"z-y"` where it is X).
+    Two {
+        /// The segment axis fixed in the proximal segment.
+        proximal: Axis,
+        /// The segment axis fixed in the distal segment.
+        distal: Axis,
+    },
+}
+
+/// The unit vector of a segment axis.
+fn unit(axis: Axis) -> [f64; 3] {
+    let mut v = [0.0; 3];
+    v[axis.index()] = 1.0;
+    v
 }
 
 impl Hinge {
-    /// The hinge axis in the proximal and in the distal segment frame (unit).
-    pub fn segment_axes(self) -> ([f64; 3], [f64; 3]) {
+    /// The two-axis hinge whose constant Z-Y-X angle is `held`: of the other
+    /// two axes, the earlier in Z-Y-X order is fixed in the proximal segment
+    /// (`R = R_1(a) R_2(b)` turns about the proximal frame's axis 1 and the
+    /// distal frame's axis 2).
+    pub fn two_axes_holding(held: Axis) -> Hinge {
+        let [proximal, distal] = match held {
+            Axis::X => [Axis::Z, Axis::Y],
+            Axis::Y => [Axis::Z, Axis::X],
+            Axis::Z => [Axis::Y, Axis::X],
+        };
+        Hinge::Two { proximal, distal }
+    }
+
+    /// The segment axis fixed in the proximal and the one fixed in the
+    /// distal segment (the same axis twice for a one-axis hinge).
+    pub fn axes(self) -> (Axis, Axis) {
         match self {
-            Hinge::Single(a) => {
-                let mut v = [0.0; 3];
-                v[a.index()] = 1.0;
-                (v, v)
-            }
-            Hinge::ZX => ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+            Hinge::Single(a) => (a, a),
+            Hinge::Two { proximal, distal } => (proximal, distal),
         }
     }
 
-    /// The name in model files: `x`, `y`, `z` or `z-x`.
+    /// The hinge axis in the proximal and in the distal segment frame (unit).
+    pub fn segment_axes(self) -> ([f64; 3], [f64; 3]) {
+        let (p, d) = self.axes();
+        (unit(p), unit(d))
+    }
+
+    /// The name in model files: `x`, `y`, `z`, `z-y`, `z-x` or `y-x`.
     pub fn name(self) -> &'static str {
         match self {
             Hinge::Single(a) => a.name(),
-            Hinge::ZX => "z-x",
+            Hinge::Two {
+                proximal: Axis::Z,
+                distal: Axis::Y,
+            } => "z-y",
+            Hinge::Two {
+                proximal: Axis::Y, ..
+            } => "y-x",
+            Hinge::Two { .. } => "z-x",
         }
     }
 }
@@ -218,9 +255,11 @@ impl TryFrom<String> for Hinge {
             "x" => Ok(Hinge::Single(Axis::X)),
             "y" => Ok(Hinge::Single(Axis::Y)),
             "z" => Ok(Hinge::Single(Axis::Z)),
-            "z-x" => Ok(Hinge::ZX),
+            "z-y" => Ok(Hinge::two_axes_holding(Axis::X)),
+            "z-x" => Ok(Hinge::two_axes_holding(Axis::Y)),
+            "y-x" => Ok(Hinge::two_axes_holding(Axis::Z)),
             _ => Err(format!(
-                "hinge = '{s}': expected x, y or z (one axis fixed in both segments) or z-x (Z fixed in the proximal segment, X in the distal)"
+                "hinge = '{s}': expected x, y or z (one axis fixed in both segments) or z-y, z-x or y-x (the first fixed in the proximal segment, the second in the distal, the third Z-Y-X angle constant)"
             )),
         }
     }
@@ -327,6 +366,17 @@ impl Joint {
             out[a.axis.index()] = if a.negative { -table[k] } else { table[k] };
         }
         out
+    }
+
+    /// The two axes a two-degree-of-freedom joint (the elbow) turns about, in
+    /// segment frames: the model's `hinge` when it names two axes, else the
+    /// two whose third angle is the table's Y (the elbow's carrying angle,
+    /// constant), wherever `angle_axes` puts it.
+    pub fn two_axis_hinge(&self) -> Hinge {
+        match self.hinge {
+            Some(h @ Hinge::Two { .. }) => h,
+            _ => Hinge::two_axes_holding(self.segment_axis(Axis::Y).axis),
+        }
     }
 
     /// Which segment-frame Z-Y-X angle the table's `axis` is, and whether it

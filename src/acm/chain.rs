@@ -330,7 +330,7 @@ impl Pass<'_> {
             .collect();
         let control = self.progress.control;
         let progress = || self.progress.window_done();
-        if let Some(method) = baselines::method_for(self.variant, &joint.kind) {
+        if let Some(method) = baselines::method_for(self.variant, joint) {
             let gyros = match (&parent_series.gyro, &child_series.gyro) {
                 (Some(p), Some(c)) => Some(baselines::JointGyros {
                     proximal: p,

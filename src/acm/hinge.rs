@@ -12,7 +12,8 @@
 //!   `sum w w^T`; isotropic noise adds a multiple of the identity to it and
 //!   leaves the direction alone.
 //! - Two-axis hinge (`hinge = "z-x"`, the elbow): Z fixed in the proximal
-//!   segment, X in the distal one, found by the Mueller estimator
+//!   segment, X in the distal one (`"z-y"` and `"y-x"` in frames whose
+//!   constant angle is X or Z), found by the Mueller estimator
 //!   ([`crate::baselines::mueller::estimate_axes`]).
 //!
 //! An estimated axis fixes two of the three degrees of freedom of its IMU's
@@ -130,7 +131,7 @@ pub fn estimate_windows(
 ) -> HingeFits {
     let half_span = match hinge {
         Hinge::Single(_) => SINGLE_AXIS_HALF_SPAN_S,
-        Hinge::ZX => MuellerOptions::default().rate_half_span_s,
+        Hinge::Two { .. } => MuellerOptions::default().rate_half_span_s,
     };
     let (rates, source) = match gyros {
         Some(g) if g.proximal.len() == rm.len() && g.distal.len() == rm.len() => (
@@ -173,7 +174,7 @@ pub fn estimate_window(
     let (np, nd) = (Vector3::from(np), Vector3::from(nd));
     let estimate = match hinge {
         Hinge::Single(_) => single_axis(rm, rates, &np, &nd),
-        Hinge::ZX => two_axes(rm, rates),
+        Hinge::Two { .. } => two_axes(rm, rates, (np, nd)),
     };
     let Some((a, b, off_axis)) = estimate else {
         let record = HingeWindow {
@@ -258,16 +259,18 @@ fn single_axis(
     Some((a, b, Some(ratio)))
 }
 
-/// Two-axis hinge: the Mueller estimate (Z in the proximal, X in the distal frame).
+/// Two-axis hinge: the Mueller estimate, starting from the segment axes
+/// `nominal` (proximal, distal).
 fn two_axes(
     rm: &[Quat],
     rates: &[Vector3<f64>],
+    nominal: (Vector3<f64>, Vector3<f64>),
 ) -> Option<(Vector3<f64>, Vector3<f64>, Option<f64>)> {
     let opts = MuellerOptions {
         max_samples: 1500,
         ..MuellerOptions::default()
     };
-    let fit = estimate_axes(rm, rates, &opts)?;
+    let fit = estimate_axes(rm, rates, nominal, &opts)?;
     Some((fit.proximal_axis.into(), fit.distal_axis.into(), None))
 }
 
@@ -279,7 +282,8 @@ fn twist_deg(q: &Quat, u: &Vector3<f64>) -> f64 {
 /// How far the joint turned about each axis over the window (max minus min),
 /// degrees. One-axis hinge: the twist about `a` of `Rm_i Rm_0^-1` (proximal
 /// frame) and about `b` of `Rm_0^-1 Rm_i` (distal frame). Two-axis hinge: the
-/// ranges of the Z and X angles once both axes are put onto the segments'.
+/// ranges of its two angles (Z and X for `z-x`) once both axes are put onto
+/// the segments'.
 fn turn_ranges(hinge: Hinge, rm: &[Quat], a: &Vector3<f64>, b: &Vector3<f64>) -> (f64, f64) {
     let range = |it: &mut dyn Iterator<Item = f64>| {
         let (lo, hi) = it.fold((f64::MAX, f64::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
@@ -297,7 +301,7 @@ fn turn_ranges(hinge: Hinge, rm: &[Quat], a: &Vector3<f64>, b: &Vector3<f64>) ->
             range(&mut rm.iter().map(|r| twist_deg(&(r * first.inverse()), a))),
             range(&mut rm.iter().map(|r| twist_deg(&(first.inverse() * r), b))),
         ),
-        Hinge::ZX => {
+        Hinge::Two { proximal, distal } => {
             let (np, nd) = hinge.segment_axes();
             let cp = swing(a, &Vector3::from(np));
             let cd_inv = swing(b, &Vector3::from(nd)).inverse();
@@ -306,8 +310,8 @@ fn turn_ranges(hinge: Hinge, rm: &[Quat], a: &Vector3<f64>, b: &Vector3<f64>) ->
                 .map(|r| crate::rotation::euler_zyx_deg(&(cp * r * cd_inv)))
                 .collect();
             (
-                range(&mut angles.iter().map(|e| e[2])),
-                range(&mut angles.iter().map(|e| e[0])),
+                range(&mut angles.iter().map(|e| e[proximal.index()])),
+                range(&mut angles.iter().map(|e| e[distal.index()])),
             )
         }
     }

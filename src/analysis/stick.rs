@@ -6,8 +6,9 @@
 //! base segment starting at the origin. A segment's direction is given in its
 //! IMU's frame (model `segment_direction`, the zero pose), so its direction in
 //! G is `G_R_imu d`. A segment starts at the far end of its proximal segment,
-//! or at its start when the two point in opposite directions in the zero pose
-//! (legs leave the pelvis where the spine starts).
+//! or at its start when that is the base segment and the two point in
+//! opposite directions in the zero pose (legs leave the pelvis where the spine
+//! starts, while arms hanging in a standing pose leave the top of the trunk).
 
 use crate::model::Model;
 use crate::rotation::Quat;
@@ -79,10 +80,11 @@ impl Skeleton {
                 .position(|b| b.imu == j.proximal)
                 .ok_or_else(|| format!("model {}: '{}' has no segment", model.name, j.proximal))?;
             let p = bones[parent].direction;
+            let against = p[0] * d[0] + p[1] * d[1] + p[2] * d[2] < 0.0;
             bones.push(Bone {
                 imu: j.distal.clone(),
                 parent: Some(parent),
-                at_parent_end: p[0] * d[0] + p[1] * d[1] + p[2] * d[2] >= 0.0,
+                at_parent_end: parent != 0 || !against,
                 direction: d,
                 length_m: l,
             });
@@ -245,5 +247,49 @@ mod tests {
         let e = Skeleton::of(&m).unwrap_err();
         assert!(e.contains("segment_length_m") && e.contains("head"), "{e}");
         assert!(Skeleton::of(&Model::builtin("opensim").unwrap()).is_ok());
+    }
+
+    #[test]
+    fn standing_models_stand_in_their_pose() {
+        // In the standing pose (x forward, y left, z up; arms hanging) the
+        // head is the highest point, the feet the lowest and forward, and the
+        // hands hang from the shoulders beside the hips.
+        for name in ["opensim", "full_body16", "opensense_lower"] {
+            let m = Model::builtin(name).unwrap();
+            let s = Skeleton::of(&m).unwrap();
+            let pose = s.pose(|_| Some(Quat::identity()));
+            let ends: Vec<[f64; 3]> = pose.iter().map(|p| p.unwrap()[1]).collect();
+            let top = ends.iter().map(|e| e[2]).fold(f64::MIN, f64::max);
+            let low = ends.iter().map(|e| e[2]).fold(f64::MAX, f64::min);
+            assert!(top > 0.3 && low < -0.7, "{name}: {low}..{top}");
+            for (b, e) in s.bones.iter().zip(&ends) {
+                let d = b.direction;
+                if d == [1.0, 0.0, 0.0] {
+                    // A foot: from the ankle, forward, at the bottom.
+                    assert!(e[2] < -0.7 && e[0] > 0.1, "{name} {}: {e:?}", b.imu);
+                } else if d == [0.0, 0.0, -1.0] && b.parent.is_some_and(|p| p != 0) {
+                    // Arms and shanks hang below their parent's far end.
+                    let parent_end = ends[b.parent.unwrap()];
+                    assert!(e[2] < parent_end[2], "{name} {}", b.imu);
+                }
+            }
+            let mut arms = 0;
+            for (k, b) in s.bones.iter().enumerate() {
+                let Some(p) = b.parent.filter(|&p| p != 0) else {
+                    continue;
+                };
+                if b.direction == [0.0, 0.0, -1.0] && s.bones[p].direction == [0.0, 0.0, 1.0] {
+                    // An upper arm hangs from the top of the trunk, not the pelvis.
+                    let start = pose[k].unwrap()[0];
+                    assert!(start[2] > 0.2, "{name} {}: {start:?}", b.imu);
+                    arms += 1;
+                }
+            }
+            assert_eq!(
+                arms,
+                if name == "opensense_lower" { 0 } else { 2 },
+                "{name}"
+            );
+        }
     }
 }

@@ -18,6 +18,7 @@
 pub mod mueller;
 pub mod rivest;
 
+use crate::model::{Hinge, Joint};
 use crate::rotation::{angle_deg, canonical, euler_zyx_deg, quat_from_euler_zyx_deg, wxyz, Quat};
 use crate::run::WindowSolution;
 use crate::variant::Variant;
@@ -34,8 +35,12 @@ use serde::{Deserialize, Serialize};
 pub enum Method {
     /// Rivest (2005), for joints of kind `knee`.
     Rivest,
-    /// Mueller et al. (2017), for joints of kind `elbow`.
-    Mueller,
+    /// Mueller et al. (2017), for joints of kind `elbow`, turning about the
+    /// two segment axes `axes` ([`Joint::two_axis_hinge`]).
+    Mueller {
+        /// The joint's proximal-fixed and distal-fixed segment axes.
+        axes: Hinge,
+    },
 }
 
 impl Method {
@@ -43,19 +48,21 @@ impl Method {
     pub fn joint_kind(self) -> &'static str {
         match self {
             Method::Rivest => "knee",
-            Method::Mueller => "elbow",
+            Method::Mueller { .. } => "elbow",
         }
     }
 }
 
-/// The baseline that corrects a joint of `kind` in `variant`, if any.
-pub fn method_for(variant: Variant, kind: &str) -> Option<Method> {
+/// The baseline that corrects `joint` in `variant`, if any (by its kind).
+pub fn method_for(variant: Variant, joint: &Joint) -> Option<Method> {
     let m = match variant {
         Variant::Rivest => Method::Rivest,
-        Variant::Mueller => Method::Mueller,
+        Variant::Mueller => Method::Mueller {
+            axes: joint.two_axis_hinge(),
+        },
         _ => return None,
     };
-    (m.joint_kind() == kind).then_some(m)
+    (m.joint_kind() == joint.kind).then_some(m)
 }
 
 /// Where Mueller's angular rates came from.
@@ -132,7 +139,7 @@ pub fn solve_joint(
 ) -> BaselineSolution {
     match method {
         Method::Rivest => solve_rivest(time_s, measured, windows),
-        Method::Mueller => solve_mueller(time_s, measured, gyros, windows),
+        Method::Mueller { axes } => solve_mueller(time_s, measured, gyros, windows, axes),
     }
 }
 
@@ -209,10 +216,12 @@ fn solve_mueller(
     measured: &[Quat],
     gyros: Option<JointGyros>,
     windows: &[Window],
+    axes: Hinge,
 ) -> BaselineSolution {
     let opts = MuellerOptions::default();
     let (rates, source) = mueller_rates(time_s, measured, gyros, &opts);
-    let fit = estimate_axes(measured, &rates, &opts);
+    let (np, nd) = axes.segment_axes();
+    let fit = estimate_axes(measured, &rates, (np.into(), nd.into()), &opts);
     let series: Vec<Quat> = match &fit {
         Some(f) => measured
             .iter()
@@ -279,6 +288,7 @@ fn mean_rotation(qs: &[Quat]) -> Quat {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Axis;
     use crate::rotation::quat_axis_angle_deg;
     use crate::window::{layout, whole_trial};
 
@@ -309,11 +319,46 @@ mod tests {
 
     #[test]
     fn only_the_methods_joint_kind_gets_the_baseline() {
-        assert_eq!(method_for(Variant::Rivest, "knee"), Some(Method::Rivest));
-        assert_eq!(method_for(Variant::Rivest, "elbow"), None);
-        assert_eq!(method_for(Variant::Mueller, "elbow"), Some(Method::Mueller));
-        assert_eq!(method_for(Variant::Mueller, "knee"), None);
-        assert_eq!(method_for(Variant::DriftCentroid, "knee"), None);
+        let model = crate::model::Model::infant13();
+        let (knee, elbow) = (
+            model.joint("l_knee").unwrap(),
+            model.joint("l_elbow").unwrap(),
+        );
+        let zx = Hinge::Two {
+            proximal: Axis::Z,
+            distal: Axis::X,
+        };
+        assert_eq!(method_for(Variant::Rivest, knee), Some(Method::Rivest));
+        assert_eq!(method_for(Variant::Rivest, elbow), None);
+        assert_eq!(
+            method_for(Variant::Mueller, elbow),
+            Some(Method::Mueller { axes: zx })
+        );
+        assert_eq!(method_for(Variant::Mueller, knee), None);
+        assert_eq!(method_for(Variant::DriftCentroid, knee), None);
+    }
+
+    #[test]
+    fn mueller_turns_about_the_axes_of_the_models_frames() {
+        // Standing frames put the elbow's carrying angle (the table's Y) on
+        // the segments' X: flexion and pronation turn about Z and Y.
+        for name in ["full_body16", "opensim"] {
+            let model = crate::model::Model::builtin(name).unwrap();
+            for side in ["l_elbow", "r_elbow"] {
+                let elbow = model.joint(side).unwrap();
+                assert_eq!(elbow.segment_axis(Axis::Y).axis, Axis::X, "{name} {side}");
+                assert_eq!(
+                    method_for(Variant::Mueller, elbow),
+                    Some(Method::Mueller {
+                        axes: Hinge::Two {
+                            proximal: Axis::Z,
+                            distal: Axis::Y
+                        }
+                    }),
+                    "{name} {side}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -21,7 +21,14 @@
 //! The joint angles then follow from the axes: each IMU is turned by the least
 //! rotation that takes its estimated axis onto the segment's (`a` onto Z, `b`
 //! onto X), and the Z-Y-X angles of the corrected joint rotation are read as
-//! usual. A misalignment that turns an IMU about its own hinge axis changes no
+//! usual.
+//!
+//! Z and X are the axes of frames whose elbow holds its Y angle (the thesis's
+//! prone frames). Where a model's frames put the elbow's constant angle on
+//! another segment axis (standing models: [`crate::model::Joint::two_axis_hinge`]),
+//! the two moving axes take their place: the earlier of them in Z-Y-X order is
+//! the proximal one. Every function here takes the segment axes `nominal`
+//! (proximal, distal) and the fit records them. A misalignment that turns an IMU about its own hinge axis changes no
 //! angular rate direction: it is an angle offset that no axis estimate can see,
 //! and it passes into the angles unchanged.
 //!
@@ -31,9 +38,18 @@ use crate::rotation::Quat;
 use nalgebra::{Matrix2, Matrix3, Unit, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// The axes of the workbench's Z-Y-X convention: the proximal-fixed first axis
-/// (Z) and the distal-fixed last axis (X).
+/// The axes of the workbench's Z-Y-X convention when the Y angle is the
+/// constant one: the proximal-fixed first axis (Z) and the distal-fixed last
+/// axis (X). Sidecars written before fits recorded their axes used these.
 pub const NOMINAL_AXES: ([f64; 3], [f64; 3]) = ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+
+fn nominal_proximal() -> [f64; 3] {
+    NOMINAL_AXES.0
+}
+
+fn nominal_distal() -> [f64; 3] {
+    NOMINAL_AXES.1
+}
 
 /// Tuning of the estimation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,9 +84,17 @@ pub struct MuellerFit {
     pub proximal_axis: [f64; 3],
     /// Unit axis `b` fixed in the distal IMU frame (X of the joint).
     pub distal_axis: [f64; 3],
-    /// Angle between `a` and the proximal IMU's Z axis, degrees.
+    /// The proximal segment axis `a` stands for (unit, segment frame; Z
+    /// unless the model's frames hold another angle constant).
+    #[serde(default = "nominal_proximal")]
+    pub proximal_nominal: [f64; 3],
+    /// The distal segment axis `b` stands for (unit, segment frame; X unless
+    /// the model's frames hold another angle constant).
+    #[serde(default = "nominal_distal")]
+    pub distal_nominal: [f64; 3],
+    /// Angle between `a` and the proximal IMU's own nominal axis, degrees.
     pub proximal_tilt_deg: f64,
-    /// Angle between `b` and the distal IMU's X axis, degrees.
+    /// Angle between `b` and the distal IMU's own nominal axis, degrees.
     pub distal_tilt_deg: f64,
     /// J at the estimate (eq. 2.25), dimensionless, in [0, 1].
     pub cost: f64,
@@ -253,11 +277,13 @@ fn descend(
 
 /// Estimates the axes from joint rotations `Rm` (distal to proximal IMU frame)
 /// and relative rates `rates` (rad/s, proximal IMU frame), starting from the
-/// IMUs' own axes ([`NOMINAL_AXES`]) and from a few tilted starts; the lowest J
-/// wins. `None` when fewer than 10 samples move faster than the minimum rate.
+/// IMUs' own axes `nominal` (proximal, distal: unit segment axes, e.g.
+/// [`NOMINAL_AXES`]) and from a few tilted starts; the lowest J wins. `None`
+/// when fewer than 10 samples move faster than the minimum rate.
 pub fn estimate_axes(
     rm: &[Quat],
     rates: &[Vector3<f64>],
+    nominal: (Vector3<f64>, Vector3<f64>),
     opts: &MuellerOptions,
 ) -> Option<MuellerFit> {
     let min_rate = opts.min_rate_deg_s.to_radians();
@@ -277,8 +303,7 @@ pub fn estimate_axes(
             inv_norm2: 1.0 / rates[k].norm_squared(),
         })
         .collect();
-    let nominal_a = Vector3::from(NOMINAL_AXES.0);
-    let nominal_b = Vector3::from(NOMINAL_AXES.1);
+    let (nominal_a, nominal_b) = (nominal.0.normalize(), nominal.1.normalize());
     let pa = Spherical::around(&nominal_a);
     let pb = Spherical::around(&nominal_b);
     let eq = std::f64::consts::FRAC_PI_2;
@@ -312,6 +337,8 @@ pub fn estimate_axes(
     Some(MuellerFit {
         proximal_axis: a.into(),
         distal_axis: b.into(),
+        proximal_nominal: nominal_a.into(),
+        distal_nominal: nominal_b.into(),
         proximal_tilt_deg: angle_between_axes_deg(&a, &nominal_a),
         distal_tilt_deg: angle_between_axes_deg(&b, &nominal_b),
         cost,
@@ -348,13 +375,14 @@ pub fn swing(from: &Vector3<f64>, to: &Vector3<f64>) -> Quat {
 
 impl MuellerFit {
     /// The corrections `(C_prox, C_dist)` of the two IMU frames: the least
-    /// rotations taking `a` onto Z and `b` onto X.
+    /// rotations taking `a` and `b` onto their segment axes (Z and X unless
+    /// the model's frames hold another angle constant).
     pub fn corrections(&self) -> (Quat, Quat) {
         let a = Vector3::from(self.proximal_axis);
         let b = Vector3::from(self.distal_axis);
         (
-            swing(&a, &Vector3::from(NOMINAL_AXES.0)),
-            swing(&b, &Vector3::from(NOMINAL_AXES.1)),
+            swing(&a, &Vector3::from(self.proximal_nominal)),
+            swing(&b, &Vector3::from(self.distal_nominal)),
         )
     }
 
@@ -390,6 +418,10 @@ impl MuellerFit {
 mod tests {
     use super::*;
     use crate::rotation::{quat_axis_angle_deg, quat_from_euler_zyx_deg};
+
+    fn zx() -> (Vector3<f64>, Vector3<f64>) {
+        (NOMINAL_AXES.0.into(), NOMINAL_AXES.1.into())
+    }
 
     /// An elbow moving in flexion and pronation, sensors tilted off the axes.
     fn elbow(n: usize, dt: f64) -> (Vec<f64>, Vec<Quat>, Quat, Quat) {
@@ -444,7 +476,7 @@ mod tests {
         let want_a = ma.inverse() * Vector3::z();
         let want_b = mb.inverse() * Vector3::x();
         let opts = MuellerOptions::default();
-        let fit = estimate_axes(&rm, &rates_from_orientations(&t, &rm, 0.02), &opts).unwrap();
+        let fit = estimate_axes(&rm, &rates_from_orientations(&t, &rm, 0.02), zx(), &opts).unwrap();
         assert!(angle_between_axes_deg(&fit.proximal_axis.into(), &want_a) < 0.5);
         assert!(angle_between_axes_deg(&fit.distal_axis.into(), &want_b) < 0.5);
         assert!(fit.cost < 1e-3 && fit.cost_nominal > 10.0 * fit.cost);
@@ -459,7 +491,8 @@ mod tests {
             .windows(2)
             .map(|w| w[0] * Quat::from_scaled_axis((w[0].inverse() * w[1]).scaled_axis() * 0.5))
             .collect();
-        let g = estimate_axes(&mid, &rates_from_gyros(&mid, &gyro_p, &gyro_d), &opts).unwrap();
+        let g =
+            estimate_axes(&mid, &rates_from_gyros(&mid, &gyro_p, &gyro_d), zx(), &opts).unwrap();
         assert!(angle_between_axes_deg(&g.proximal_axis.into(), &want_a) < 0.5);
         assert!(angle_between_axes_deg(&g.distal_axis.into(), &want_b) < 0.5);
     }
@@ -480,6 +513,6 @@ mod tests {
     fn too_little_movement_gives_no_estimate() {
         let rm = vec![Quat::identity(); 100];
         let rates = vec![Vector3::zeros(); 100];
-        assert!(estimate_axes(&rm, &rates, &MuellerOptions::default()).is_none());
+        assert!(estimate_axes(&rm, &rates, zx(), &MuellerOptions::default()).is_none());
     }
 }

@@ -67,7 +67,7 @@ pub const PRESETS: [&str; 5] = [
     "full_body_swing",
 ];
 pub use elbow::{
-    flexion_deg as elbow_flexion_deg, forearm_rate as elbow_forearm_rate,
+    elbow_joint, flexion_deg as elbow_flexion_deg, forearm_rate as elbow_forearm_rate,
     pronation_deg as elbow_pronation_deg, ELBOW_IMUS,
 };
 pub use gyro::GyroSim;
@@ -303,7 +303,9 @@ impl SimConfig {
         match self.kind {
             SimKind::Knee { .. } => KNEE_IMUS.iter().map(|s| s.to_string()).collect(),
             SimKind::FullBody | SimKind::Swing => model.imus.clone(),
-            SimKind::Elbow { .. } => ELBOW_IMUS.iter().map(|s| s.to_string()).collect(),
+            SimKind::Elbow { .. } => elbow::elbow_joint(model)
+                .map(|j| vec![j.proximal.clone(), j.distal.clone()])
+                .unwrap_or_default(),
         }
     }
 
@@ -342,6 +344,12 @@ impl SimConfig {
                     "misalignment angle must be finite, found {angle_deg}"
                 ));
             }
+        }
+        if matches!(self.kind, SimKind::Elbow { .. }) && elbow::elbow_joint(model).is_none() {
+            return err(format!(
+                "the elbow test needs a joint of kind 'elbow'; model '{}' has none",
+                model.name
+            ));
         }
         let imus = self.imus(model);
         let check_imu = |imu: &str, what: &str| -> Result<(), SimError> {
@@ -556,7 +564,10 @@ fn segments_at(config: &SimConfig, model: &Model, time_s: &[f64]) -> Vec<(String
     match config.kind {
         SimKind::Knee { .. } => knee_segments(time_s),
         SimKind::FullBody => full_body_segments(model, config.seed, time_s),
-        SimKind::Elbow { .. } => elbow::segments(time_s),
+        SimKind::Elbow { .. } => match elbow::elbow_joint(model) {
+            Some(joint) => elbow::segments(joint, time_s),
+            None => vec![],
+        },
         SimKind::Swing => swing::segments(model, config.seed, time_s),
     }
 }
@@ -712,7 +723,9 @@ fn misalignments(
         }
     }
     if let SimKind::Elbow { angle_deg } = config.kind {
-        out.extend(elbow::misalignments(config.seed, angle_deg).map(|(n, m)| (n.to_string(), m)));
+        if let Some(joint) = elbow::elbow_joint(model) {
+            out.extend(elbow::misalignments(joint, config.seed, angle_deg));
+        }
     }
     match &config.misalignment {
         Misalignment::None => {}
