@@ -17,6 +17,8 @@ pub enum Variant {
     DriftHeadingCentroid,
     Ik,
     Hinge,
+    /// Per joint, the ACM variant its own figures favour (`acm::auto`).
+    Auto,
     None,
     /// `basic` with the centroid term: registered only with the
     /// `demo-variant` feature, to show that this file is the one place a
@@ -36,6 +38,8 @@ pub enum Kind {
     Baseline,
     /// IMU inverse kinematics: joint coordinates within hard limits.
     Ik,
+    /// Per joint, one of several ACM variants, chosen without truth.
+    Auto,
     /// No correction.
     None,
 }
@@ -169,6 +173,18 @@ pub const VARIANTS: &[VariantInfo] = &[
         "As `drift-centroid`, with the hinge axes of the model's hinge joints \
          estimated in both IMUs' frames: they fix two degrees of freedom of \
          the distal IMU's correction and of the proximal one's.",
+    ),
+    row(
+        Variant::Auto,
+        "auto",
+        "auto",
+        "auto",
+        Kind::Auto,
+        (true, false, false),
+        "Per joint in chain order, the one of drift-heading-centroid, \
+         drift-heading, drift-centroid, drift and none that keeps the joint \
+         inside its limits with the steadiest correction (docs/method.md section 19); \
+         the choice and its figures are in the sidecar.",
     ),
     row(
         Variant::None,

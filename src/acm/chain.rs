@@ -109,7 +109,7 @@ pub fn recorrect_chain(
                 .joints
                 .iter()
                 .position(|p| p.distal == j.proximal)
-                .filter(|_| previous.variant.heading())
+                .filter(|_| previous.variant.heading() || previous.variant == Variant::Auto)
                 .unwrap_or(k);
             redo.insert(parent);
             redo.extend(model.descendants(parent));
@@ -151,12 +151,25 @@ fn run(
     reuse: Option<(&Correction, &BTreeSet<usize>)>,
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
+    let candidates = match variant {
+        Variant::Auto => super::auto::CANDIDATES,
+        _ => std::slice::from_ref(&variant),
+    };
     let windows = if variant.windowed() {
         layout(&trial.time_s, settings.window_s, settings.hop_s)
     } else {
         whole_trial(&trial.time_s)
     };
-    let (todo, skipped) = plan_joints(trial, model, limits, variant);
+    // One plan per candidate: its limits (with or without the centroid
+    // term) and, for `hinge`, its axes. The joints are the same in each.
+    let mut plans: Vec<(Variant, Vec<(usize, JointLimits)>)> = Vec::new();
+    let mut skipped = Vec::new();
+    for &v in candidates {
+        let (todo, s) = plan_joints(trial, model, limits, v);
+        plans.push((v, todo));
+        skipped = s;
+    }
+    let todo = plans[0].1.clone();
     let mut hinges = hinge_fits(trial, model, &todo, variant, &windows);
     let solve_count = todo
         .iter()
@@ -164,7 +177,7 @@ fn run(
         .count();
     let progress = Progress {
         done: AtomicUsize::new(0),
-        total: solve_count * windows.len(),
+        total: solve_count * windows.len() * candidates.len(),
         control,
     };
     let mut corrected = trial.clone();
@@ -173,37 +186,66 @@ fn run(
     let mut headings: HashMap<usize, ImuHeading> = HashMap::new();
     let max_depth = depths.iter().copied().max().unwrap_or(0);
     for depth in 0..=max_depth {
-        let level: Vec<&(usize, JointLimits)> =
-            todo.iter().filter(|(k, _)| depths[*k] == depth).collect();
-        for (k, _) in &level {
+        let level: Vec<usize> = (0..todo.len())
+            .filter(|&i| depths[todo[i].0] == depth)
+            .collect();
+        for &i in &level {
             turn_uncorrected_proximal(
                 &mut corrected,
                 trial,
                 model,
                 &todo,
-                *k,
+                todo[i].0,
                 &mut hinges,
                 &windows,
             );
         }
-        let pass = Pass {
-            trial,
-            model,
-            settings,
-            variant,
-            reuse,
-            windows: &windows,
-            todo: &todo,
-            hinges: &hinges,
-            corrected: &corrected,
-            results: &results,
-            progress: &progress,
-        };
-        let solved: Vec<Solved> = level
+        let passes: Vec<Pass> = plans
+            .iter()
+            .map(|(v, todo)| Pass {
+                trial,
+                model,
+                settings,
+                variant: *v,
+                reuse,
+                windows: &windows,
+                todo,
+                hinges: &hinges,
+                corrected: &corrected,
+                results: &results,
+                progress: &progress,
+            })
+            .collect();
+        let jobs: Vec<(usize, usize)> = level
+            .iter()
+            .flat_map(|&i| (0..passes.len()).map(move |c| (i, c)))
+            .collect();
+        let mut solved: Vec<Solved> = jobs
             .par_iter()
-            .map(|(k, lim)| pass.solve_joint(*k, lim))
+            .map(|&(i, c)| {
+                let (k, lim) = &passes[c].todo[i];
+                passes[c].solve_joint(*k, lim)
+            })
             .collect::<Result<_, Cancelled>>()?;
-        for (k, result, applied, heading) in solved {
+        drop(passes);
+        let mut chosen: Vec<Solved> = Vec::with_capacity(level.len());
+        while !solved.is_empty() {
+            let rest = solved.split_off(candidates.len());
+            let mine = std::mem::replace(&mut solved, rest);
+            chosen.push(if candidates.len() == 1 || mine[0].1.auto.is_some() {
+                // A single variant, or a joint an earlier run chose for.
+                mine.into_iter().next().expect("one candidate")
+            } else {
+                let forced = reuse
+                    .and_then(|(prev, _)| prev.joint(&model.joints[mine[0].0].name))
+                    .and_then(|r| r.auto.as_ref())
+                    .filter(|a| a.overridden.is_some())
+                    .map(|a| a.chosen);
+                let lists = (candidates, forced);
+                choose(trial, model, limits, &corrected, lists, mine)
+            });
+        }
+        for (k, result, applied, heading) in chosen {
             if let Some(h) = heading {
                 headings.insert(k, h);
             }
@@ -225,6 +267,46 @@ fn run(
         skipped,
         ik: None,
     })
+}
+
+/// Picks one of a joint's candidate solutions (`auto`), or the one the user
+/// forced, recording the choice in its result.
+fn choose(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    corrected: &Trial,
+    (variants, forced): (&[Variant], Option<Variant>),
+    mine: Vec<Solved>,
+) -> Solved {
+    let k = mine[0].0;
+    let joint = &model.joints[k];
+    let raw = trial.imu(&joint.distal).expect("present");
+    let candidates: Vec<super::auto::Candidate> = mine
+        .iter()
+        .zip(variants)
+        .map(
+            |((_, r, applied, heading), &variant)| super::auto::Candidate {
+                variant,
+                distal: applied.orientations(&raw.orientation),
+                windows: &r.windows,
+                heading: heading.as_ref(),
+            },
+        )
+        .collect();
+    let view = super::auto::JointCandidates {
+        joint,
+        limits: limits.joint_limits(&joint.name, &joint.kind, true),
+        parent: &corrected.imu(&joint.proximal).expect("present").orientation,
+        raw: &raw.orientation,
+        candidates,
+    };
+    let choice = super::auto::choose(&view, forced);
+    drop(view);
+    let pick = choice.chosen_index;
+    let (k, mut result, applied, heading) = mine.into_iter().nth(pick).expect("a candidate");
+    result.auto = Some(choice.record);
+    (k, result, applied, heading)
 }
 
 /// The joints to correct, each with its limits (by index in the model's
@@ -315,7 +397,15 @@ impl Pass<'_> {
             baseline,
             hinge: self.hinges.get(&k).map(|f| f.record.clone()),
             axis_from: families.as_ref().and_then(|f| f.from_child.clone()),
+            auto: None,
         };
+        if self.variant == Variant::None {
+            // `auto`'s fallback: the joint left as measured.
+            let windows = self.identity_windows(joint, lim);
+            let raw = self.trial.imu(&joint.distal).expect("present");
+            let applied = Applied::Kept(raw.orientation.clone(), raw.gyro.clone());
+            return Ok((k, result(windows, None), applied, None));
+        }
         if self.variant.heading() {
             let (windows, applied, heading) = self.solve_heading_joint(joint, lim)?;
             return Ok((k, result(windows, None), applied, Some(heading)));
@@ -369,6 +459,34 @@ impl Pass<'_> {
         };
         let applied = Applied::Series(sol.series, GyroUpdate::Turn);
         Ok((k, result(sol.windows, None), applied, None))
+    }
+
+    /// The windows of a joint left uncorrected: C = identity, at its cost.
+    fn identity_windows(&self, joint: &Joint, lim: &JointLimits) -> Vec<WindowSolution> {
+        let parent = &self.corrected.imu(&joint.proximal).expect("present");
+        let child = &self.trial.imu(&joint.distal).expect("present");
+        self.windows
+            .iter()
+            .map(|w| {
+                let measured: Vec<Quat> = (w.first..w.end)
+                    .map(|i| parent.orientation[i].inverse() * child.orientation[i])
+                    .collect();
+                let cost =
+                    WindowCost::new(&measured, lim, self.settings.lambda1).eval(&Quat::identity());
+                self.progress.window_done();
+                WindowSolution {
+                    start_s: w.start_s,
+                    end_s: w.end_s,
+                    centre_s: w.centre_s,
+                    samples: w.len(),
+                    correction: [1.0, 0.0, 0.0, 0.0],
+                    angle_deg: 0.0,
+                    cost,
+                    cost_uncorrected: cost,
+                    evaluations: 1,
+                }
+            })
+            .collect()
     }
 
     /// An earlier run's result for joint `k`, when the run re-solves other joints only.
@@ -662,6 +780,20 @@ enum Applied {
     /// Corrected orientations and gyroscope readings to take as they are (a
     /// heading fit, or an earlier run's kept result).
     Kept(Vec<Quat>, Gyros),
+}
+
+impl Applied {
+    /// The distal IMU's corrected orientations, from its measured ones.
+    fn orientations(&self, raw: &[Quat]) -> Vec<Quat> {
+        match self {
+            Applied::Series(series, _) => raw
+                .iter()
+                .zip(series)
+                .map(|(q, c)| Quat::new_normalize((*q * c).into_inner()))
+                .collect(),
+            Applied::Kept(orientation, _) => orientation.clone(),
+        }
+    }
 }
 
 /// What a per-sample correction `C(t)` does to the distal IMU's gyros.

@@ -8,6 +8,7 @@
 //! The heading-drift variants fit `G_R_dist' = R_up(-h(t)) G_R_dist C` per IMU
 //! instead ([`heading`]), looking ahead at the joints below it ([`lookahead`]).
 
+pub mod auto;
 pub mod chain;
 pub mod cost;
 pub mod heading;
@@ -55,6 +56,9 @@ pub struct JointResult {
     /// where that axis was observed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axis_from: Option<String>,
+    /// How `auto` chose this joint's correction among the candidates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub auto: Option<auto::AutoChoice>,
 }
 
 /// The heading correction of one window of a heading-drift variant.

@@ -44,6 +44,31 @@ pub struct JointRow {
     pub outside_after_pct: f64,
     /// Mean rotation angle of the distal IMU's applied correction, degrees.
     pub correction_deg: f64,
+    /// How `auto` chose this joint's correction (the `auto` variant only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub auto: Option<AutoRow>,
+}
+
+/// `auto`'s choice for one joint, as the manifest records it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AutoRow {
+    pub chosen: Variant,
+    pub runner_up: Option<Variant>,
+    /// The figures that decided, in one line.
+    pub reason: String,
+    pub flags: Vec<String>,
+}
+
+impl AutoRow {
+    /// `joint=chosen(runner-up)`, with `!` when flagged: the CSV's cell part.
+    fn cell(&self, joint: &str) -> String {
+        format!(
+            "{joint}={}({}){}",
+            self.chosen,
+            self.runner_up.map_or("-".to_string(), |v| v.to_string()),
+            if self.flags.is_empty() { "" } else { "!" }
+        )
+    }
 }
 
 /// One trial corrected with one variant.
@@ -134,6 +159,7 @@ impl Row {
                     outside_before_pct: b.excursion.pct_outside_any,
                     outside_after_pct: a.excursion.pct_outside_any,
                     correction_deg: a.shift.map_or(0.0, |s| s.mean_correction_angle_deg),
+                    auto: None,
                 })
             })
             .collect();
@@ -151,6 +177,22 @@ impl Row {
         self.worst_joint = worst.map(|j| j.joint.clone());
         self.worst_after_deg = worst.map(|j| j.excursion_after_deg);
         self.joints = joints;
+    }
+
+    /// Records `auto`'s choice per joint from its correction's joint results.
+    pub fn set_auto(&mut self, joints: &[crate::acm::JointResult]) {
+        for row in &mut self.joints {
+            row.auto = joints
+                .iter()
+                .find(|j| j.joint == row.joint)
+                .and_then(|j| j.auto.as_ref())
+                .map(|a| AutoRow {
+                    chosen: a.chosen,
+                    runner_up: a.runner_up,
+                    reason: a.reason.clone(),
+                    flags: a.flags.clone(),
+                });
+        }
     }
 
     /// The order of rows in a manifest: by trial, then variant.
@@ -255,6 +297,7 @@ impl Manifest {
             "worst_joint",
             "worst_after_deg",
             "correction_deg",
+            "auto_choice",
             "warnings",
             "error",
             "wall_s",
@@ -280,6 +323,11 @@ impl Manifest {
                 r.worst_joint.clone().unwrap_or_default(),
                 num(r.worst_after_deg),
                 num(r.correction_deg),
+                r.joints
+                    .iter()
+                    .filter_map(|j| j.auto.as_ref().map(|a| a.cell(&j.joint)))
+                    .collect::<Vec<_>>()
+                    .join(" "),
                 r.warnings.join("; "),
                 r.error.clone().unwrap_or_default(),
                 format!("{:.3}", r.wall_s),
@@ -369,5 +417,99 @@ impl Manifest {
             .collect();
         paths.sort();
         paths.iter().map(|p| Manifest::load(p)).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::acm::auto::AutoChoice;
+    use crate::acm::JointResult;
+
+    fn joint(name: &str, auto: Option<AutoChoice>) -> JointResult {
+        JointResult {
+            joint: name.into(),
+            proximal: "a".into(),
+            distal: "b".into(),
+            lambda2: 0.0,
+            parent_corrected: false,
+            windows: vec![],
+            baseline: None,
+            hinge: None,
+            axis_from: None,
+            auto,
+        }
+    }
+
+    #[test]
+    fn auto_choices_go_to_the_json_rows_and_one_csv_cell() {
+        let choice = |chosen, runner_up, flags: Vec<String>| AutoChoice {
+            chosen,
+            runner_up,
+            reason: "score 0.10 deg".into(),
+            flags,
+            candidates: vec![],
+            overridden: None,
+        };
+        let mut row = Row::failed(Path::new("t.csv"), Variant::Auto, String::new());
+        row.joints = ["back", "l_knee", "neck"]
+            .iter()
+            .map(|j| JointRow {
+                joint: j.to_string(),
+                excursion_before_deg: 1.0,
+                excursion_after_deg: 0.5,
+                outside_before_pct: 10.0,
+                outside_after_pct: 5.0,
+                correction_deg: 3.0,
+                auto: None,
+            })
+            .collect();
+        row.set_auto(&[
+            joint(
+                "back",
+                Some(choice(
+                    Variant::DriftHeadingCentroid,
+                    Some(Variant::DriftHeading),
+                    vec![],
+                )),
+            ),
+            joint(
+                "l_knee",
+                Some(choice(
+                    Variant::None,
+                    Some(Variant::Drift),
+                    vec!["uncorrected".into()],
+                )),
+            ),
+            joint("neck", None),
+        ]);
+        assert_eq!(row.joints[1].auto.as_ref().unwrap().chosen, Variant::None);
+        assert!(row.joints[2].auto.is_none());
+        let m = Manifest {
+            program: "acmw".into(),
+            version: "0".into(),
+            shard: None,
+            variants: vec![Variant::Auto],
+            settings: Settings::default(),
+            limits_source: String::new(),
+            limits_sha256: String::new(),
+            rows: vec![row],
+        };
+        let csv = m.to_csv();
+        let mut r = csv::Reader::from_reader(csv.as_bytes());
+        let column = r
+            .headers()
+            .unwrap()
+            .iter()
+            .position(|h| h == "auto_choice")
+            .unwrap();
+        let rec = r.records().next().unwrap().unwrap();
+        assert_eq!(
+            &rec[column],
+            "back=drift-heading-centroid(drift-heading) l_knee=none(drift)!"
+        );
+        let json = serde_json::to_string(&m).unwrap();
+        let back: Manifest = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, m);
     }
 }

@@ -458,6 +458,7 @@ impl Batch<'_> {
                 let c = pipeline::correct(&prepared.trial, setup, variant, &RunControl::default())?;
                 let report = pipeline::report(&prepared, setup, None, [&c]);
                 row.set_figures(&report.uncorrected, &report.variants[0].joints);
+                row.set_auto(&c.joints);
                 row.warnings.extend(
                     c.skipped
                         .iter()

@@ -246,6 +246,51 @@ pub fn correct_many(
     Ok(out)
 }
 
+/// `auto`'s correction `previous` with the user's choice `choice` for
+/// `joint` (`None`, or `auto`'s own choice: no override), the joint and the
+/// joints below it solved again. The override is recorded in the joint's
+/// `auto` record (and so in the sidecar) and kept by later re-corrections.
+/// A joint `auto` did not choose for (or a variant that is not one of its
+/// candidates) leaves `previous` as it was.
+pub fn override_auto(
+    trial: &Trial,
+    setup: Setup,
+    previous: &Correction,
+    joint: &str,
+    choice: Option<Variant>,
+    control: &RunControl,
+) -> Result<Correction, Cancelled> {
+    let mut edited = previous.clone();
+    let Some(a) = edited
+        .joints
+        .iter_mut()
+        .find(|j| j.joint == joint)
+        .and_then(|j| j.auto.as_mut())
+    else {
+        return Ok(previous.clone());
+    };
+    let own = a.overridden.unwrap_or(a.chosen);
+    match choice.filter(|&v| v != own && crate::acm::auto::CANDIDATES.contains(&v)) {
+        Some(v) => {
+            a.chosen = v;
+            a.overridden = Some(own);
+        }
+        None => {
+            a.chosen = own;
+            a.overridden = None;
+        }
+    }
+    recorrect(
+        trial,
+        setup.model,
+        setup.limits,
+        setup.settings,
+        &edited,
+        &[joint],
+        control,
+    )
+}
+
 /// The figures of the prepared trial before and after each correction
 /// (`truth`: the true segment orientations, when known).
 pub fn report<'c>(

@@ -24,7 +24,7 @@ pub fn correct_trial(
     match variant.kind() {
         Kind::Ik => correct_ik(trial, model, settings, control),
         Kind::None => Ok(acm::uncorrected(trial, model, limits, settings)),
-        Kind::Acm | Kind::Heading | Kind::Baseline => {
+        Kind::Acm | Kind::Heading | Kind::Baseline | Kind::Auto => {
             acm::correct_chain(trial, model, limits, settings, variant, control)
         }
     }
@@ -46,7 +46,7 @@ pub fn recorrect(
         // Inverse kinematics and no correction do not read the limit table
         // or the settings.
         Kind::Ik | Kind::None => Ok(previous.clone()),
-        Kind::Acm | Kind::Heading | Kind::Baseline => {
+        Kind::Acm | Kind::Heading | Kind::Baseline | Kind::Auto => {
             acm::recorrect_chain(trial, model, limits, settings, previous, joints, control)
         }
     }

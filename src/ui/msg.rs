@@ -100,6 +100,9 @@ pub struct RunJob {
     pub settings: Settings,
     /// Re-correct these joints of the previous results (None: run afresh).
     pub recorrect: Option<(Vec<Arc<Correction>>, Vec<String>)>,
+    /// With `recorrect`: override `auto`'s choice for this joint with this
+    /// variant (None: back to auto's own); the other variants are kept.
+    pub auto_override: Option<(String, Option<Variant>)>,
 }
 
 /// Everything that happens to the workbench.

@@ -773,3 +773,55 @@ fn hints_are_dropped_whole_when_narrow() {
     assert_eq!(fit_hints(line, 6), "? help");
     assert_eq!(fit_hints("a b  c d", 5), "a b");
 }
+
+#[test]
+fn compare_shows_and_overrides_autos_choice_per_joint() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    app.select_file("fb.csv.gz");
+    key(&mut app, KeyCode::Enter);
+    keys(&mut app, "r");
+    keys(&mut app, "c");
+    key(&mut app, KeyCode::Down);
+    let joint = app.open_joints()[app.joint].clone();
+    let record = |app: &App| {
+        let e = app.open_entry().unwrap();
+        let c = &e.results[&Variant::Auto].correction;
+        c.joint(&joint).unwrap().auto.clone().unwrap()
+    };
+    let before = record(&app);
+    assert_eq!(before.overridden, None);
+    // `o`: the next candidate, recorded as the user's over auto's own.
+    keys(&mut app, "o");
+    let after = record(&app);
+    let candidates = crate::acm::auto::CANDIDATES;
+    let k = candidates.iter().position(|v| *v == before.chosen).unwrap();
+    assert_eq!(after.chosen, candidates[(k + 1) % candidates.len()]);
+    assert_eq!(after.overridden, Some(before.chosen));
+    assert!(
+        after.reason.starts_with("chosen by the user"),
+        "{}",
+        after.reason
+    );
+    // The other variants are untouched; auto's joint now is that variant's
+    // candidate: its figures are the chosen candidate's.
+    assert_eq!(app.open_entry().unwrap().results.len(), Variant::ALL.len());
+    while Variant::ALL[app.compare_col] != Variant::Auto {
+        key(&mut app, KeyCode::Right);
+    }
+    snap("compare_auto_override", &app);
+    // Saved with the override in the sidecar.
+    key(&mut app, KeyCode::Char(' '));
+    keys(&mut app, "w");
+    let out = fx.root().join("trials/corrected/fb.auto.csv.gz");
+    assert!(out.exists(), "{:?}", app.message);
+    let sc = crate::sidecar::Sidecar::load(&crate::sidecar::sidecar_path(&out)).unwrap();
+    let j = sc.joints.iter().find(|j| j.joint == joint).unwrap();
+    assert_eq!(j.auto.as_ref().unwrap().overridden, Some(before.chosen));
+    // Cycling through every candidate comes back to auto's own choice.
+    for _ in 1..candidates.len() {
+        keys(&mut app, "o");
+    }
+    let back = record(&app);
+    assert_eq!((back.chosen, back.overridden), (before.chosen, None));
+}

@@ -690,7 +690,23 @@ impl Workbench {
             limits_source,
             settings,
             recorrect,
+            auto_override: None,
         })))
+    }
+
+    /// The job re-correcting `auto` of `file` with the user's `choice` for
+    /// `joint` (None: auto's own); the other variants' results are kept.
+    pub fn override_effect(
+        &mut self,
+        file: &str,
+        joint: &str,
+        choice: Option<Variant>,
+    ) -> Option<Effect> {
+        let mut effect = self.run_effect(file, Some(vec![joint.to_string()]))?;
+        if let Effect::Run(job) = &mut effect {
+            job.auto_override = Some((joint.to_string(), choice));
+        }
+        Some(effect)
     }
 
     /// Shows the next variant.

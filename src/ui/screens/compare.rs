@@ -134,6 +134,7 @@ pub fn render(col: usize, app: &Workbench, theme: &Theme, f: &mut Frame, area: R
         ));
     }
     lines.push(Line::from(spans));
+    lines.extend(auto_lines(app, e, theme, area.width as usize));
     lines.push(Line::from(""));
     let mut status = vec![];
     for v in Variant::ALL {
@@ -162,6 +163,46 @@ pub fn render(col: usize, app: &Workbench, theme: &Theme, f: &mut Frame, area: R
     f.render_widget(Paragraph::new(lines), area);
 }
 
+/// `auto`'s choice for the selected joint: the variant, the runner-up, the
+/// figures that decided and the flags (nothing before `auto` has run).
+fn auto_lines(
+    app: &Workbench,
+    e: &crate::ui::workbench::TrialEntry,
+    theme: &Theme,
+    width: usize,
+) -> Vec<Line<'static>> {
+    let joints = app.open_joints();
+    let Some(a) = (joints.get(app.joint))
+        .and_then(|j| e.results.get(&Variant::Auto)?.correction.joint(j))
+        .and_then(|r| r.auto.clone())
+    else {
+        return vec![];
+    };
+    let joint = &joints[app.joint];
+    let who = match a.overridden {
+        Some(own) => format!("yours, auto chose {own}"),
+        None => format!(
+            "runner-up {}",
+            a.runner_up.map_or("-".into(), |v| v.to_string())
+        ),
+    };
+    let mut lines = vec![Line::from(Span::styled(
+        fit(
+            &format!("  auto, {joint}: {} ({who}); o overrides", a.chosen),
+            width,
+        ),
+        theme.header,
+    ))];
+    lines.push(Line::from(fit(&format!("    {}", a.reason), width)));
+    for flag in &a.flags {
+        lines.push(Line::from(Span::styled(
+            fit(&format!("    ! {flag}"), width),
+            theme.warn,
+        )));
+    }
+    lines
+}
+
 /// The variant columns (indices into `Variant::ALL`) that fit in `width`
 /// after `fixed` characters, `col_w` each, scrolled to show `selected`.
 fn visible_columns(
@@ -176,6 +217,35 @@ fn visible_columns(
     start..start + fit
 }
 
+/// Overrides `auto`'s choice for the selected joint with the next of its
+/// candidates (back to auto's own after the last).
+fn override_next(app: &mut Workbench, file: &str) -> Reply {
+    let joints = app.open_joints();
+    let Some(joint) = joints.get(app.joint).cloned() else {
+        return Reply::default();
+    };
+    let record = app
+        .entry(file)
+        .and_then(|e| e.results.get(&Variant::Auto))
+        .and_then(|r| r.correction.joint(&joint)?.auto.clone());
+    let Some(a) = record else {
+        app.error(format!(
+            "run the corrections first (r): auto has not chosen for {joint}"
+        ));
+        return Reply::default();
+    };
+    let candidates = crate::acm::auto::CANDIDATES;
+    let k = candidates.iter().position(|v| *v == a.chosen).unwrap_or(0);
+    let next = candidates[(k + 1) % candidates.len()];
+    let own = a.overridden.unwrap_or(a.chosen);
+    let choice = (next != own).then_some(next);
+    app.info(match choice {
+        Some(v) => format!("{joint}: {v} instead of auto's {own}; correcting..."),
+        None => format!("{joint}: back to auto's {own}; correcting..."),
+    });
+    app.override_effect(file, &joint, choice).into()
+}
+
 /// What a key does on the compare screen; `col` is the picked column.
 pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
     let Some(file) = app.open.clone() else {
@@ -188,6 +258,8 @@ pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
         Action::Up => app.joint = app.joint.saturating_sub(1),
         Action::Down => app.joint = (app.joint + 1).min(app.open_joints().len().saturating_sub(1)),
         Action::Run => return app.run_effect(&file, None).into(),
+        // `o` here: the next of auto's candidates for the selected joint.
+        Action::Globe => return override_next(app, &file),
         Action::Choose | Action::Enter => {
             // The choice is this trial's; the variant shown stays as it is.
             let v = Variant::ALL[*col];
