@@ -28,10 +28,27 @@ pub fn max_input_bytes() -> u64 {
         .saturating_mul(1 << 20)
 }
 
+/// Every path [`open_regular`] opened, in unit tests: how often an input is read.
+#[cfg(test)]
+pub(crate) static OPENED: std::sync::Mutex<Vec<std::path::PathBuf>> =
+    std::sync::Mutex::new(Vec::new());
+
+/// How many times the unit tests so far opened `path` through [`open_regular`].
+#[cfg(test)]
+pub(crate) fn times_opened(path: &Path) -> usize {
+    let opened = OPENED.lock().unwrap_or_else(|e| e.into_inner());
+    opened.iter().filter(|p| p.as_path() == path).count()
+}
+
 /// Opens `path` for reading when it is a regular file (symbolic links
 /// followed). FIFOs, sockets, devices and folders are refused without
 /// blocking: the file is opened non-blocking and checked before any read.
 pub fn open_regular(path: &Path) -> io::Result<File> {
+    #[cfg(test)]
+    OPENED
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(path.to_path_buf());
     let meta = std::fs::metadata(path)?;
     check_kind(&meta)?;
     let mut options = std::fs::OpenOptions::new();
@@ -135,24 +152,31 @@ pub fn read_text_located(path: &Path) -> Result<String, ReadFailure> {
         error,
     };
     let bytes = read_bytes(path).map_err(whole)?;
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        let bytes = e.as_bytes();
-        let before = String::from_utf8_lossy(&bytes[..at]);
-        let line = before.matches('\n').count() as u64 + 1;
-        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        ReadFailure {
-            line,
-            column,
-            error: io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!(
-                    "expected UTF-8 text, found invalid byte 0x{:02x}",
-                    bytes[at]
-                ),
+    String::from_utf8(bytes).map_err(|e| invalid_utf8(e.as_bytes(), e.utf8_error().valid_up_to()))
+}
+
+/// The bytes as UTF-8 text; where they are not, the line and column of the
+/// first invalid byte (as [`read_text_located`] reports it).
+pub fn str_of(bytes: &[u8]) -> Result<&str, ReadFailure> {
+    std::str::from_utf8(bytes).map_err(|e| invalid_utf8(bytes, e.valid_up_to()))
+}
+
+/// The failure of text whose first invalid UTF-8 byte is at `at`.
+fn invalid_utf8(bytes: &[u8], at: usize) -> ReadFailure {
+    let before = String::from_utf8_lossy(&bytes[..at]);
+    let line = before.matches('\n').count() as u64 + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    ReadFailure {
+        line,
+        column,
+        error: io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!(
+                "expected UTF-8 text, found invalid byte 0x{:02x}",
+                bytes[at]
             ),
-        }
-    })
+        ),
+    }
 }
 
 /// Decompresses gzip data (all members), at most [`max_input_bytes`] out.

@@ -126,20 +126,10 @@ impl Named for TrialFormat {
         TrialFormat::Sto,
     ];
     fn name(self) -> &'static str {
-        match self {
-            TrialFormat::QuatCsv => "quat-csv",
-            TrialFormat::EulerCsv => "euler-csv",
-            TrialFormat::Sto => "sto",
-            TrialFormat::Xsens => "xsens",
-        }
+        self.row().name
     }
     fn help(self) -> &'static str {
-        match self {
-            TrialFormat::QuatCsv => "time,<imu>_qw,<imu>_qx,<imu>_qy,<imu>_qz,... (canonical CSV)",
-            TrialFormat::EulerCsv => "time,<imu>_roll,<imu>_pitch,<imu>_yaw,..., degrees, Z-Y-X",
-            TrialFormat::Sto => "OpenSim orientation .sto (OpenSense)",
-            TrialFormat::Xsens => "Xsens MT Manager exports (read only)",
-        }
+        self.row().help
     }
 }
 
@@ -174,6 +164,15 @@ mod tests {
         check::<KneeAxis>();
         check::<TrialFormat>();
         assert_eq!(serde_name(TrialFormat::Xsens), TrialFormat::Xsens.name());
+        let writable: Vec<TrialFormat> = (crate::trial::format::FORMATS.iter())
+            .filter(|r| r.writable)
+            .map(|r| r.format)
+            .collect();
+        assert_eq!(
+            TrialFormat::CHOICES,
+            writable,
+            "the choices are the writable formats"
+        );
     }
 
     #[test]

@@ -205,12 +205,10 @@ impl Sidecar {
         Ok(sidecar)
     }
 
-    /// `None` when `input` hashes to the recorded input SHA-256, else the hash found.
-    pub fn check_input(&self, input: &Path) -> anyhow::Result<Option<String>> {
-        let bytes = crate::trial::input_bytes(input)
-            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", input.display()))?;
-        let found = sha256_hex(&bytes);
-        Ok((found != self.input.sha256).then_some(found))
+    /// `None` when an input whose SHA-256 is `found` (hex) is the one
+    /// recorded, else `found`.
+    pub fn check_input<'a>(&self, found: &'a str) -> Option<&'a str> {
+        (found != self.input.sha256).then_some(found)
     }
 
     /// Pretty JSON text.
@@ -238,10 +236,10 @@ impl Sidecar {
 }
 
 /// A warning when the sidecar beside the trial file `path` does not describe
-/// these bytes of it (the file was replaced after the sidecar was written, or
-/// a save was cut short between them); `None` when it does, or there is no
-/// sidecar or it records no output hash.
-pub fn mismatch_warning(path: &Path, bytes: &[u8]) -> Option<String> {
+/// the bytes of it read, whose SHA-256 is `sha256` (hex): the file was
+/// replaced after the sidecar was written, or a save was cut short between
+/// them. `None` when it does, or there is no sidecar or it records no output hash.
+pub fn mismatch_warning(path: &Path, sha256: &str) -> Option<String> {
     let sc_path = sidecar_path(path);
     if !sc_path.is_file() {
         return None;
@@ -250,7 +248,7 @@ pub fn mismatch_warning(path: &Path, bytes: &[u8]) -> Option<String> {
         Ok(s) => s.output_sha256?,
         Err(e) => return Some(format!("sidecar beside it is unreadable: {e}")),
     };
-    (sha256_hex(bytes) != recorded).then(|| {
+    (sha256 != recorded).then(|| {
         format!(
             "{} does not describe this file (output SHA-256 differs): the file changed after that correction was saved",
             sc_path.display()
@@ -262,10 +260,7 @@ pub fn mismatch_warning(path: &Path, bytes: &[u8]) -> Option<String> {
 /// `corrected/<stem>.<variant>.<ext>[.gz]` in the input's folder.
 pub fn default_output(input: &Path, variant: Variant, format: TrialFormat, gzip: bool) -> PathBuf {
     let stem = crate::file_names::stem_without(input, &crate::file_names::TRIAL_SUFFIXES);
-    let ext = match format {
-        TrialFormat::Sto => "sto",
-        _ => "csv",
-    };
+    let ext = format.extension();
     let gz = if gzip { ".gz" } else { "" };
     input
         .parent()
@@ -279,6 +274,8 @@ pub struct SaveRequest<'a> {
     /// The file the raw trial was read from.
     pub input: &'a Path,
     pub input_format: TrialFormat,
+    /// SHA-256 (hex) of the input's bytes as the trial was read from them.
+    pub input_sha256: &'a str,
     /// The trial as the correction saw it: as read, or pose-calibrated.
     pub trial: &'a Trial,
     /// The pose calibration that made `trial` from the file, if any.
@@ -296,14 +293,12 @@ pub struct SaveRequest<'a> {
 }
 
 impl SaveRequest<'_> {
-    /// The sidecar record of this correction (reads the input file for its hash).
-    pub fn sidecar(&self) -> anyhow::Result<Sidecar> {
-        let bytes = crate::trial::input_bytes(self.input)
-            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", self.input.display()))?;
+    /// The sidecar record of this correction.
+    pub fn sidecar(&self) -> Sidecar {
         let input = InputRecord {
             file: self.input.display().to_string(),
             format: self.input_format,
-            sha256: sha256_hex(&bytes),
+            sha256: self.input_sha256.to_string(),
             samples: self.trial.len(),
             imus: self.trial.imus.iter().map(|i| i.name.clone()).collect(),
         };
@@ -333,13 +328,13 @@ impl SaveRequest<'_> {
             coordinates_file: coordinates_path(self.output).display().to_string(),
             summary: run.summary(),
         });
-        Ok(s)
+        s
     }
 
     /// Writes the corrected trial and its sidecar, each atomically (previous
     /// files are kept as `.bak`). Returns the sidecar's path.
     pub fn save(&self) -> anyhow::Result<PathBuf> {
-        self.save_with(self.sidecar()?)
+        self.save_with(self.sidecar())
     }
 
     /// Writes the corrected trial and the given sidecar (built by

@@ -131,26 +131,54 @@ fn bounded_hop(total: f64, win_s: f64, hop_s: f64) -> f64 {
     }
 }
 
+/// Why drift windows do not suit a trial ([`check_layout`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LayoutError {
+    /// A window spans fewer than [`MIN_WINDOW_SAMPLES`] median intervals.
+    #[error("window_s = {window_s} s holds fewer than {min} samples at this trial's median interval of {dt_s} s; expected a longer window", min = MIN_WINDOW_SAMPLES)]
+    ShortWindow {
+        /// Window length, seconds.
+        window_s: f64,
+        /// The trial's median sample interval, seconds.
+        dt_s: f64,
+    },
+    /// The trial would need more than [`MAX_WINDOWS`] windows.
+    #[error("window_s = {window_s} s and hop_s = {hop_s} s lay this {length_s:.1}-s trial out in {count:e} windows; expected at most {max} (a longer hop)", max = MAX_WINDOWS)]
+    TooManyWindows {
+        /// Window length and hop, seconds.
+        window_s: f64,
+        hop_s: f64,
+        /// The trial's length, seconds.
+        length_s: f64,
+        /// Windows the layout would need.
+        count: f64,
+    },
+}
+
 /// Why windows of `win_s` and hop `hop_s` seconds do not suit the trial with
 /// these sample times, if they do not: a window must hold at least
 /// [`MIN_WINDOW_SAMPLES`] median intervals, and the trial must need no more
 /// than [`MAX_WINDOWS`] windows.
-pub fn check_layout(time_s: &[f64], win_s: f64, hop_s: f64) -> Result<(), String> {
+pub fn check_layout(time_s: &[f64], win_s: f64, hop_s: f64) -> Result<(), LayoutError> {
     let total = trial_length_s(time_s);
     if time_s.len() < 2 || total <= win_s + EPS {
         return Ok(());
     }
     let dt = median_dt(time_s);
     if win_s < MIN_WINDOW_SAMPLES * dt {
-        return Err(format!(
-            "window_s = {win_s} s holds fewer than {MIN_WINDOW_SAMPLES} samples at this trial's median interval of {dt} s; expected a longer window"
-        ));
+        return Err(LayoutError::ShortWindow {
+            window_s: win_s,
+            dt_s: dt,
+        });
     }
     let count = ((total - win_s) / hop_s).ceil() + 1.0;
     if !(hop_s > 0.0 && count <= MAX_WINDOWS as f64) {
-        return Err(format!(
-            "window_s = {win_s} s and hop_s = {hop_s} s lay this {total:.1}-s trial out in {count:e} windows; expected at most {MAX_WINDOWS} (a longer hop)"
-        ));
+        return Err(LayoutError::TooManyWindows {
+            window_s: win_s,
+            hop_s,
+            length_s: total,
+            count,
+        });
     }
     Ok(())
 }
@@ -379,10 +407,15 @@ mod tests {
         // Settings that would need billions of windows are refused by the check
         // and bounded by the layout itself.
         let t = times(100.0, 100.0);
-        assert!(check_layout(&t, 1e-6, 1e-6)
-            .unwrap_err()
-            .contains("fewer than 4 samples"));
-        assert!(check_layout(&t, 1.0, 1e-6).unwrap_err().contains("windows"));
+        let e = check_layout(&t, 1e-6, 1e-6).unwrap_err();
+        assert!(matches!(e, LayoutError::ShortWindow { .. }), "{e}");
+        assert!(e.to_string().contains("fewer than 4 samples"), "{e}");
+        let e = check_layout(&t, 1.0, 1e-6).unwrap_err();
+        assert!(matches!(e, LayoutError::TooManyWindows { .. }), "{e}");
+        assert!(
+            e.to_string().contains("windows; expected at most 100000"),
+            "{e}"
+        );
         assert!(check_layout(&t, 60.0, 30.0).is_ok());
         assert!(layout(&t, 1.0, 1e-6).len() <= MAX_WINDOWS);
         assert!(layout(&t, 1.0, 0.0).len() <= MAX_WINDOWS);

@@ -45,24 +45,54 @@ fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     (n.is_finite() && n > 1e-9).then(|| v.map(|x| x / n))
 }
 
+/// What a model lacks for a stick figure ([`Skeleton::of`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("model {model}: {what} '{imu}'")]
+pub struct SkeletonError {
+    pub model: String,
+    /// The IMU whose segment is at fault.
+    pub imu: String,
+    pub what: Missing,
+}
+
+/// The part of a segment a model lacks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Missing {
+    /// No positive `segment_length_m`.
+    Length,
+    /// No non-zero `segment_direction`.
+    Direction,
+    /// A joint's proximal IMU has no segment of its own.
+    Segment,
+}
+
+impl std::fmt::Display for Missing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Missing::Length => "no positive segment_length_m for",
+            Missing::Direction => "no segment_direction (a non-zero [x, y, z]) for",
+            Missing::Segment => "no segment for",
+        })
+    }
+}
+
 impl Skeleton {
     /// The skeleton of a model; an error names the first IMU whose length
     /// (`[segment_length_m]`) or direction (`[segment_direction]`) is missing
     /// or unusable.
-    pub fn of(model: &Model) -> Result<Skeleton, String> {
-        let bone = |imu: &str| -> Result<([f64; 3], f64), String> {
+    pub fn of(model: &Model) -> Result<Skeleton, SkeletonError> {
+        let missing = |imu: &str, what: Missing| SkeletonError {
+            model: model.name.clone(),
+            imu: imu.to_string(),
+            what,
+        };
+        let bone = |imu: &str| -> Result<([f64; 3], f64), SkeletonError> {
             let len = model.segment_length_m.get(imu).copied();
             let dir = model.segment_direction.get(imu).copied();
             match (len, dir.and_then(unit)) {
                 (Some(l), Some(d)) if l.is_finite() && l > 0.0 => Ok((d, l)),
-                (None, _) | (Some(_), Some(_)) => Err(format!(
-                    "model {}: no positive segment_length_m for '{imu}'",
-                    model.name
-                )),
-                (_, None) => Err(format!(
-                    "model {}: no segment_direction (a non-zero [x, y, z]) for '{imu}'",
-                    model.name
-                )),
+                (None, _) | (Some(_), Some(_)) => Err(missing(imu, Missing::Length)),
+                (_, None) => Err(missing(imu, Missing::Direction)),
             }
         };
         let (d, l) = bone(&model.base)?;
@@ -78,7 +108,7 @@ impl Skeleton {
             let parent = bones
                 .iter()
                 .position(|b| b.imu == j.proximal)
-                .ok_or_else(|| format!("model {}: '{}' has no segment", model.name, j.proximal))?;
+                .ok_or_else(|| missing(&j.proximal, Missing::Segment))?;
             let p = bones[parent].direction;
             let against = p[0] * d[0] + p[1] * d[1] + p[2] * d[2] < 0.0;
             bones.push(Bone {
@@ -238,13 +268,15 @@ mod tests {
         let mut m = Model::infant13();
         m.segment_direction.remove("l_calf");
         let e = Skeleton::of(&m).unwrap_err();
+        assert_eq!((e.what, e.imu.as_str()), (Missing::Direction, "l_calf"));
+        let e = e.to_string();
         assert!(
             e.contains("segment_direction") && e.contains("l_calf"),
             "{e}"
         );
         let mut m = Model::infant13();
         m.segment_length_m.remove("head");
-        let e = Skeleton::of(&m).unwrap_err();
+        let e = Skeleton::of(&m).unwrap_err().to_string();
         assert!(e.contains("segment_length_m") && e.contains("head"), "{e}");
         assert!(Skeleton::of(&Model::builtin("opensim").unwrap()).is_ok());
     }

@@ -17,7 +17,7 @@ use crate::input::sha256_hex;
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
 use crate::sidecar::sidecar_path;
-use crate::trial::{detect_format, detect_model, input_bytes, is_trial_path, TrialFormat};
+use crate::trial::{detect_format, is_trial_path, TrialFormat};
 use crate::variant::Variant;
 use manifest::{Manifest, Row, Status};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -186,13 +186,25 @@ pub enum Event<'r> {
 }
 
 impl Batch<'_> {
-    /// The output of `trial` with `variant`: `<out_dir>/<stem>.<variant>.<ext>`.
+    /// The output of `trial` with `variant`: `<out_dir>/<stem>.<variant>.<ext>`
+    /// (reads the trial's header for its format).
     pub fn output_path(&self, trial: &Path, variant: Variant) -> PathBuf {
         let (format, gzip) = match detect_format(trial) {
             Ok((f, g)) => (f, g),
             // A trial that cannot be read fails before its output is named.
             Err(_) => (TrialFormat::QuatCsv, false),
         };
+        self.output_of(trial, format, gzip, variant)
+    }
+
+    /// [`Batch::output_path`] of a trial read as `format`, gzip-compressed or not.
+    fn output_of(
+        &self,
+        trial: &Path,
+        format: TrialFormat,
+        gzip: bool,
+        variant: Variant,
+    ) -> PathBuf {
         let format = self.format.unwrap_or(format.output_default());
         let name = crate::sidecar::default_output(trial, variant, format, gzip);
         self.out_dir.join(name.file_name().unwrap_or_default())
@@ -221,10 +233,20 @@ impl Batch<'_> {
             .collect()
     }
 
-    /// Checks that no two trials would write the same output.
+    /// Checks that no two trials would write the same output. Outputs are
+    /// named by the trial's stem, so only trials that share a stem can
+    /// collide, and only their headers are read (for the extension).
     pub fn check_outputs(&self, trials: &[PathBuf]) -> Result<(), BatchError> {
-        let mut seen: HashMap<PathBuf, &Path> = HashMap::new();
+        use crate::file_names::{stem_without, TRIAL_SUFFIXES};
+        let mut stems: HashMap<String, usize> = HashMap::new();
         for t in trials {
+            *stems.entry(stem_without(t, &TRIAL_SUFFIXES)).or_default() += 1;
+        }
+        let shared = trials
+            .iter()
+            .filter(|t| stems[&stem_without(t, &TRIAL_SUFFIXES)] > 1);
+        let mut seen: HashMap<PathBuf, &Path> = HashMap::new();
+        for t in shared {
             let out = self.output_path(t, Variant::None);
             if let Some(first) = seen.insert(out.clone(), t) {
                 return Err(BatchError::Collision {
@@ -381,41 +403,26 @@ impl Batch<'_> {
                 .collect();
             (rows, false)
         };
-        let bytes = match input_bytes(path) {
-            Ok(b) => b,
-            Err(e) => return fail_all(format!("{}: cannot read: {e}", path.display())),
+        // The one read of the input: its hash, its model and its trial.
+        let file = match pipeline::read(path) {
+            Ok(f) => f,
+            Err(e) => return fail_all(e.to_string()),
         };
-        let input_sha256 = sha256_hex(&bytes);
-        drop(bytes);
         let model = match self.model {
             Some(m) => m.clone(),
-            None => detect_model(path),
+            None => file.detect_model(),
         };
+        let (format, gzip) = (file.format, file.gzip);
+        let output = |v: Variant| self.output_of(path, format, gzip, v);
         let base = Row {
-            input_sha256,
+            input_sha256: file.sha256.clone(),
             settings_sha256: self.settings_sha256(&model),
             table_sha256: self.limits.hash(),
             status: Status::Ok,
             error: None,
             ..Row::failed(path, Variant::None, String::new())
         };
-        // Rows an earlier run finished with the same inputs, output intact.
-        let done: Vec<Option<Row>> = self
-            .variants
-            .iter()
-            .map(|&v| {
-                let r = earlier.get(&(base.trial.clone(), v))?;
-                let same = r.status == Status::Ok
-                    && r.input_sha256 == base.input_sha256
-                    && r.settings_sha256 == base.settings_sha256
-                    && r.table_sha256 == base.table_sha256
-                    && r.version == base.version
-                    && r.output == self.output_path(path, v).display().to_string()
-                    && Path::new(&r.sidecar).is_file()
-                    && std::fs::read(&r.output).is_ok_and(|b| sha256_hex(&b) == r.output_sha256);
-                same.then(|| r.clone())
-            })
-            .collect();
+        let done = self.earlier_rows(&base, earlier, &output);
         if done.iter().all(Option::is_some) {
             return (done.into_iter().flatten().collect(), true);
         }
@@ -427,11 +434,13 @@ impl Batch<'_> {
         };
         let prepared = (|| -> anyhow::Result<_> {
             self.limits.check_covers(&model, self.limits_source)?;
-            let loaded = pipeline::load(path, &model)?;
+            let loaded = pipeline::load_file(&file, &model)?;
             let prepared = pipeline::prepare(loaded.trial, setup, self.preparation)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             Ok((loaded.source, prepared))
         })();
+        // The text read is parsed: only the trial is kept from here on.
+        drop(file);
         let (source, prepared) = match prepared {
             Ok(p) => p,
             Err(e) => return fail_all(format!("{e:#}")),
@@ -451,27 +460,10 @@ impl Batch<'_> {
                 warnings: warnings.clone(),
                 ..base.clone()
             };
-            let output = self.output_path(path, variant);
+            let output = output(variant);
             row.output = output.display().to_string();
             row.sidecar = sidecar_path(&output).display().to_string();
-            let result = (|| -> anyhow::Result<()> {
-                let c = pipeline::correct(&prepared.trial, setup, variant, &RunControl::default())?;
-                let report = pipeline::report(&prepared, setup, None, [&c]);
-                row.set_figures(&report.uncorrected, &report.variants[0].joints);
-                row.set_auto(&c.joints);
-                row.warnings.extend(
-                    c.skipped
-                        .iter()
-                        .map(|s| format!("skipped {}: {}", s.joint, s.reason)),
-                );
-                let mut out = source.default_output(variant, self.format);
-                out.path = output.clone();
-                pipeline::save(&source, &prepared, &c, setup, &out)?;
-                let written = std::fs::read(&output)
-                    .map_err(|e| anyhow::anyhow!("{}: cannot read back: {e}", output.display()))?;
-                row.output_sha256 = sha256_hex(&written);
-                Ok(())
-            })();
+            let result = self.correct_one(&source, &prepared, setup, output, &mut row);
             if let Err(e) = result {
                 row.status = Status::Failed;
                 row.error = Some(format!("{e:#}"));
@@ -480,6 +472,60 @@ impl Batch<'_> {
             rows.push(row);
         }
         (rows, false)
+    }
+
+    /// Per variant, the row an earlier run finished with the same input
+    /// (`base`'s hashes), settings, table and program version, whose output
+    /// (named by `output`) and sidecar are still there as written.
+    fn earlier_rows(
+        &self,
+        base: &Row,
+        earlier: &HashMap<(String, Variant), Row>,
+        output: &dyn Fn(Variant) -> PathBuf,
+    ) -> Vec<Option<Row>> {
+        (self.variants.iter())
+            .map(|&v| {
+                let r = earlier.get(&(base.trial.clone(), v))?;
+                let same = r.status == Status::Ok
+                    && r.input_sha256 == base.input_sha256
+                    && r.settings_sha256 == base.settings_sha256
+                    && r.table_sha256 == base.table_sha256
+                    && r.version == base.version
+                    && r.output == output(v).display().to_string()
+                    && Path::new(&r.sidecar).is_file()
+                    && std::fs::read(&r.output).is_ok_and(|b| sha256_hex(&b) == r.output_sha256);
+                same.then(|| r.clone())
+            })
+            .collect()
+    }
+
+    /// Corrects the prepared trial with `row.variant`, saves it to `output`
+    /// (with its sidecar) and fills the row's figures, warnings and output hash.
+    fn correct_one(
+        &self,
+        source: &pipeline::Source,
+        prepared: &pipeline::Prepared,
+        setup: Setup,
+        output: PathBuf,
+        row: &mut Row,
+    ) -> anyhow::Result<()> {
+        let variant = row.variant;
+        let c = pipeline::correct(&prepared.trial, setup, variant, &RunControl::default())?;
+        let report = pipeline::report(prepared, setup, None, [&c]);
+        row.set_figures(&report.uncorrected, &report.variants[0].joints);
+        row.set_auto(&c.joints);
+        row.warnings.extend(
+            c.skipped
+                .iter()
+                .map(|s| format!("skipped {}: {}", s.joint, s.reason)),
+        );
+        let mut out = source.default_output(variant, self.format);
+        out.path = output;
+        pipeline::save(source, prepared, &c, setup, &out)?;
+        let written = std::fs::read(&out.path)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read back: {e}", out.path.display()))?;
+        row.output_sha256 = sha256_hex(&written);
+        Ok(())
     }
 }
 
@@ -517,6 +563,48 @@ mod tests {
             shard_of(Path::new("a/t0001.csv.gz"), 4),
             shard_of(Path::new("/mnt/b/t0001.csv.gz"), 4)
         );
+    }
+
+    #[test]
+    fn a_batch_reads_each_input_once_and_records_the_hash_of_what_it_read() {
+        use crate::simulate::{simulate, SimConfig};
+        let dir = tempfile::tempdir().unwrap();
+        let mut cfg = SimConfig::full_body(7);
+        cfg.duration_s = 70.0;
+        let sim = simulate(&cfg).unwrap();
+        let trial = dir.path().join("walk.csv.gz");
+        crate::trial::write_trial(&sim.trial, &trial, TrialFormat::QuatCsv).unwrap();
+        let (limits, settings) = (LimitTable::default_table(), Settings::default());
+        let prep = Preparation::default();
+        let variants = [Variant::None, Variant::Basic, Variant::Drift];
+        let batch = Batch {
+            model: None,
+            limits: &limits,
+            limits_source: "<built-in>",
+            settings: &settings,
+            preparation: &prep,
+            variants: &variants,
+            format: None,
+            out_dir: &dir.path().join("out"),
+            jobs: 1,
+            shard: None,
+        };
+        let before = crate::input::times_opened(&trial);
+        let manifest = batch.run(std::slice::from_ref(&trial), &|_| {}).unwrap();
+        // Unique stems: listing, model detection, hashing, parsing and the
+        // three saves all use the one read.
+        assert_eq!(crate::input::times_opened(&trial) - before, 1);
+        let sha256 = sha256_hex(&std::fs::read(&trial).unwrap());
+        assert_eq!(manifest.rows.len(), 3);
+        for row in &manifest.rows {
+            assert_eq!(row.status, Status::Ok, "{:?}", row.error);
+            assert_eq!(row.input_sha256, sha256);
+            let sidecar = crate::sidecar::Sidecar::load(Path::new(&row.sidecar)).unwrap();
+            assert_eq!(sidecar.input.sha256, sha256, "{}", row.sidecar);
+        }
+        // A second run resumes: it reads the input once more, for its hash.
+        batch.run(std::slice::from_ref(&trial), &|_| {}).unwrap();
+        assert_eq!(crate::input::times_opened(&trial) - before, 2);
     }
 
     #[test]

@@ -9,7 +9,8 @@ use acm_workbench::analysis::{
     pool_by_joint, pool_by_table_row, trial_refs, JointSamples, TimeSpan,
 };
 use acm_workbench::limits::LimitsDir;
-use acm_workbench::trial::{read_trial, Trial};
+use acm_workbench::model::Model;
+use acm_workbench::trial::{detect_model, read_trial, Trial};
 use anyhow::{bail, Context as _};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -108,7 +109,11 @@ pub fn load_trials(table: &TableArgs, paths: &[PathBuf]) -> anyhow::Result<(Cont
         limits: table.limits.clone(),
         ..EngineArgs::default()
     };
-    let ctx = load_context(&engine, paths.first().map(PathBuf::as_path))?;
+    let ctx = load_context(&engine, || {
+        Ok(paths
+            .first()
+            .map_or_else(Model::infant13, |p| detect_model(p)))
+    })?;
     let trials = paths
         .iter()
         .map(|p| read_trial(p, &ctx.model))

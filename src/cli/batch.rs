@@ -67,7 +67,7 @@ pub fn run(args: BatchArgs) -> anyhow::Result<i32> {
         "--threads does not apply to batch: --jobs N sets the workers"
     );
     let trials = discover(&args.inputs)?;
-    let ctx = load_context(&args.engine, None)?;
+    let ctx = load_context(&args.engine, || Ok(Model::infant13()))?;
     let model: Option<Model> = args.engine.model.as_ref().map(|_| ctx.model.clone());
     let pose = args.pose.calibration(model.as_ref().unwrap_or(&ctx.model));
     let preparation = Preparation {

@@ -6,7 +6,7 @@ use acm_workbench::limits::{LimitTable, LimitsDir, LimitsError, Settings, Settin
 use acm_workbench::model::{Model, SignedAxis};
 use acm_workbench::names::Named;
 use acm_workbench::pose::{PoseCalibration, PoseTime};
-use acm_workbench::trial::detect_model;
+use acm_workbench::trial::TrialFile;
 use acm_workbench::variant::{Variant, VARIANTS};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
@@ -78,19 +78,38 @@ impl PoseArgs {
     }
 }
 
-/// The pipeline's first two steps for the trial at `input`: read it, then
-/// prepare it as `preparation` asks, printing what the functional
+/// The trial at `input`, read once ([`pipeline::read`]), and the run's
+/// context, whose model is the one that fits the trial best unless
+/// `--model` names one (the trial is read after the flags, the limit table
+/// and the settings are checked).
+pub fn context_and_file(args: &EngineArgs, input: &Path) -> anyhow::Result<(Context, TrialFile)> {
+    let mut file = None;
+    let ctx = load_context(args, || {
+        let f = pipeline::read(input)?;
+        let model = f.detect_model();
+        file = Some(f);
+        Ok(model)
+    })?;
+    let file = match file {
+        Some(f) => f,
+        None => pipeline::read(input)?,
+    };
+    Ok((ctx, file))
+}
+
+/// The pipeline's first two steps for the trial read as `file`: load it,
+/// then prepare it as `preparation` asks, printing what the functional
 /// calibration did unless `quiet` (`announce`: say that it was applied).
 pub fn load_prepared(
     ctx: &Context,
-    input: &Path,
+    file: &TrialFile,
     preparation: &Preparation,
     announce: bool,
     quiet: bool,
 ) -> anyhow::Result<(Source, Prepared)> {
-    let loaded = pipeline::load(input, &ctx.model)?;
+    let loaded = pipeline::load_file(file, &ctx.model)?;
     let prepared = pipeline::prepare(loaded.trial, ctx.setup(), preparation)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+        .map_err(|e| anyhow::anyhow!("{}: {e}", file.path.display()))?;
     if let (Some(c), false) = (&prepared.calibration, quiet) {
         if announce {
             eprintln!(
@@ -163,29 +182,25 @@ pub fn default_limits_dir() -> PathBuf {
     PathBuf::from("joint_limits")
 }
 
-/// Resolves model, limit table and settings from the arguments.
-pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<Context> {
+/// Resolves model, limit table and settings from the arguments; without
+/// `--model` the model is `detect()`'s, called once the table and the
+/// settings are resolved.
+pub fn load_context(
+    args: &EngineArgs,
+    detect: impl FnOnce() -> anyhow::Result<Model>,
+) -> anyhow::Result<Context> {
     if let Some(n) = args.threads {
         // Ignore the error of a pool already built (tests call this twice).
         let _ = rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global();
     }
-    let model = match (&args.model, trial) {
-        (Some(m), _) => Model::load(m)?,
-        (None, Some(t)) => detect_model(t),
-        (None, None) => Model::infant13(),
-    };
+    let named = args.model.as_deref().map(Model::load).transpose()?;
     let dir = LimitsDir::load(&default_limits_dir())?;
     let (limits, limits_source) = match &args.limits {
         Some(p) => (LimitTable::load(p)?, p.display().to_string()),
         None => (dir.table, dir.table_source),
     };
-    limits.check_covers_in(
-        &model,
-        &limits_source,
-        table_text(&limits_source).as_deref(),
-    )?;
     let defaults = dir.settings.settings();
     let settings = Settings {
         lambda1: args.lambda1.unwrap_or(defaults.lambda1),
@@ -197,6 +212,15 @@ pub fn load_context(args: &EngineArgs, trial: Option<&Path>) -> anyhow::Result<C
     if let Some(p) = settings.problem() {
         return Err(flag_error(args, &p).into());
     }
+    let model = match named {
+        Some(m) => m,
+        None => detect()?,
+    };
+    limits.check_covers_in(
+        &model,
+        &limits_source,
+        table_text(&limits_source).as_deref(),
+    )?;
     Ok(Context {
         model,
         limits,

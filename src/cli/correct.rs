@@ -1,7 +1,7 @@
 //! `acmw correct`: correct a trial, write the corrected trial and its sidecar.
 
 use super::common::{
-    load_calibration, load_context, load_prepared, set_threads, variant_parser, Context,
+    context_and_file, load_calibration, load_prepared, set_threads, variant_parser, Context,
     EngineArgs, PoseArgs, Progress,
 };
 use acm_workbench::acm::{RunControl, Variant};
@@ -55,12 +55,12 @@ pub struct CorrectArgs {
 /// Runs `acmw correct`.
 pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     let mut recorded_calibration = None;
-    let (ctx, variant, pose) = match &args.from_sidecar {
+    let (ctx, variant, pose, file) = match &args.from_sidecar {
         Some(p) => {
             let s = Sidecar::load_checked(p)?;
             let origin = p.display().to_string();
-            let found = s.check_input(&args.input)?;
-            if let Some(found) = found {
+            let file = pipeline::read(&args.input)?;
+            if let Some(found) = s.check_input(&file.sha256) {
                 let what = format!(
                     "{}: SHA-256 {found} differs from the {} that {origin} records for {}",
                     args.input.display(),
@@ -89,12 +89,12 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
                 glitch_deg: acm_workbench::trial::glitch::DEFAULT_GLITCH_DEG,
             };
             let pose = s.pose_calibration.as_ref().map(|p| p.calibration);
-            (ctx, s.variant, pose)
+            (ctx, s.variant, pose, file)
         }
         None => {
-            let ctx = load_context(&args.engine, Some(&args.input))?;
+            let (ctx, file) = context_and_file(&args.engine, &args.input)?;
             let pose = args.pose.calibration(&ctx.model);
-            (ctx, args.variant, pose)
+            (ctx, args.variant, pose, file)
         }
     };
     let calibration = match recorded_calibration {
@@ -103,7 +103,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     };
     let announce = args.from_sidecar.is_none();
     let preparation = Preparation { calibration, pose };
-    let (source, prepared) = load_prepared(&ctx, &args.input, &preparation, announce, args.quiet)?;
+    let (source, prepared) = load_prepared(&ctx, &file, &preparation, announce, args.quiet)?;
     let trial = &prepared.trial;
     if !args.quiet {
         for w in &trial.warnings {

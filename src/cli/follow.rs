@@ -6,7 +6,8 @@ use super::common::{load_context, load_prepared, variant_parser, EngineArgs};
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation, Source};
 use acm_workbench::follow::{Extrapolation, Follower, FollowerConfig, Tail, TailEvent};
-use acm_workbench::trial::{detect_format, trial_to_string, TrialFormat};
+use acm_workbench::trial::format::is_followable_name;
+use acm_workbench::trial::{detect_model, trial_to_string, TrialFormat};
 use anyhow::Context as _;
 use clap::Args;
 use std::io::Write;
@@ -168,13 +169,12 @@ fn wait_for_header(
 pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     let input = &args.input;
     let name = input.display().to_string();
-    let lower = name.to_ascii_lowercase();
-    if !lower.ends_with(".csv") {
+    if !is_followable_name(input) {
         anyhow::bail!(
             "{name}: acmw follow reads a growing canonical or Euler CSV (a name ending in .csv, not compressed); `acmw correct` reads the other formats once they are complete"
         );
     }
-    if args.format == Some(TrialFormat::Sto) || args.format == Some(TrialFormat::Xsens) {
+    if args.format.is_some_and(|f| !f.row().followable) {
         anyhow::bail!("--format: acmw follow writes quat-csv or euler-csv");
     }
     let stop = Arc::new(AtomicBool::new(false));
@@ -186,7 +186,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     if !wait_for_header(input, poll, &stop, idle)? {
         anyhow::bail!("{name}: no header line arrived: expected a trial being written");
     }
-    let ctx = load_context(&args.engine, Some(input))?;
+    let ctx = load_context(&args.engine, || Ok(detect_model(input)))?;
     let variant = args.variant;
     let config = FollowerConfig {
         model: ctx.model.clone(),
@@ -340,7 +340,8 @@ fn final_correction(
     let len = std::fs::metadata(input).map(|m| m.len()).ok();
     let whole = !cut && !tail.has_partial_line() && len == Some(tail.offset());
     let (source, prepared) = if whole {
-        load_prepared(ctx, input, &Preparation::default(), false, args.quiet)?
+        let file = pipeline::read(input)?;
+        load_prepared(ctx, &file, &Preparation::default(), false, args.quiet)?
     } else {
         let trial = follower
             .trial()
@@ -359,12 +360,8 @@ fn final_correction(
                 }
             );
         }
-        let (format, gzip) = detect_format(input)?;
-        let source = Source {
-            path: input.clone(),
-            format,
-            gzip,
-        };
+        // The whole file as it is now, for its format and the sidecar's hash.
+        let source = Source::of(&pipeline::read(input)?);
         let prepared = pipeline::prepare(trial, ctx.setup(), &Preparation::default())
             .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
         (source, prepared)

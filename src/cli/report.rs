@@ -1,7 +1,7 @@
 //! `acmw report`: the figures of docs/method.md section 16 before and after each variant.
 
 use super::common::{
-    load_calibration, load_context, load_prepared, EngineArgs, PoseArgs, Progress,
+    context_and_file, load_calibration, load_prepared, EngineArgs, PoseArgs, Progress,
 };
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation};
@@ -87,12 +87,12 @@ fn positive_deg(s: &str) -> Result<f64, String> {
 
 /// Runs `acmw report`.
 pub fn run(args: ReportArgs) -> anyhow::Result<i32> {
-    let ctx = load_context(&args.engine, Some(&args.input))?;
+    let (ctx, file) = context_and_file(&args.engine, &args.input)?;
     let preparation = Preparation {
         calibration: load_calibration(args.calibration.as_deref())?,
         pose: args.pose.calibration(&ctx.model),
     };
-    let (_, prepared) = load_prepared(&ctx, &args.input, &preparation, true, args.quiet)?;
+    let (_, prepared) = load_prepared(&ctx, &file, &preparation, true, args.quiet)?;
     let trial = &prepared.trial;
     let truth = match load_truth_beside(&args.input, &ctx.model) {
         Some(t) => {

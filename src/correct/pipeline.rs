@@ -36,6 +36,7 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
+use crate::acm::window::LayoutError;
 use crate::acm::{Cancelled, Correction, RunControl, Variant};
 use crate::calibration::AppliedCalibration;
 use crate::correct::{correct_trial, recorrect};
@@ -45,7 +46,7 @@ use crate::pose::convention::check_conventions;
 use crate::pose::{calibrate, PoseCalibration, PoseError, PoseRecord};
 use crate::report::{ReportInput, TrialReport};
 use crate::sidecar::{default_output, SaveRequest};
-use crate::trial::{detect_format, read_trial, Trial, TrialError, TrialFormat};
+use crate::trial::{Trial, TrialError, TrialFile, TrialFormat};
 use std::path::{Path, PathBuf};
 
 /// What every step reads: the body model, the limit table and the engine's
@@ -67,9 +68,22 @@ pub struct Source {
     pub format: TrialFormat,
     /// Whether the file was gzip-compressed (outputs follow it by default).
     pub gzip: bool,
+    /// SHA-256 (hex) of the input's bytes as read ([`TrialFile::sha256`]),
+    /// recorded in the sidecars of its corrections.
+    pub sha256: String,
 }
 
 impl Source {
+    /// Where `file` was read from.
+    pub fn of(file: &TrialFile) -> Source {
+        Source {
+            path: file.path.clone(),
+            format: file.format,
+            gzip: file.gzip,
+            sha256: file.sha256.clone(),
+        }
+    }
+
     /// `corrected/<name>.<variant>.<ext>` beside the input, in `format` or
     /// the input format's default output.
     pub fn default_output(&self, variant: Variant, format: Option<TrialFormat>) -> Output {
@@ -89,16 +103,30 @@ pub struct LoadedTrial {
     pub trial: Trial,
 }
 
-/// Reads the trial at `path` (any format the program reads) with `model`'s IMUs.
+/// Reads the trial at `path` (any format the program reads) with `model`'s
+/// IMUs: [`read`], then [`load_file`].
 pub fn load(path: &Path, model: &Model) -> Result<LoadedTrial, TrialError> {
-    let (format, gzip) = detect_format(path)?;
-    let trial = read_trial(path, model)?;
+    load_file(&read(path)?, model)
+}
+
+/// Reads the input at `path` once (whole, hashed as read): the caller may
+/// detect its model ([`TrialFile::detect_model`]) or look at its hash
+/// before [`load_file`] parses it.
+pub fn read(path: &Path) -> Result<TrialFile, TrialError> {
+    TrialFile::read(path)
+}
+
+/// The trial in `file` with `model`'s IMUs. A trial file that a sidecar
+/// beside it describes as another version of it gets a warning.
+pub fn load_file(file: &TrialFile, model: &Model) -> Result<LoadedTrial, TrialError> {
+    let mut trial = file.trial(model)?;
+    if file.format != TrialFormat::Xsens {
+        trial
+            .warnings
+            .extend(crate::sidecar::mismatch_warning(&file.path, &file.sha256));
+    }
     Ok(LoadedTrial {
-        source: Source {
-            path: path.to_path_buf(),
-            format,
-            gzip,
-        },
+        source: Source::of(file),
         trial,
     })
 }
@@ -130,8 +158,8 @@ pub struct Prepared {
 #[derive(Debug, thiserror::Error)]
 pub enum PrepareError {
     /// The drift windows do not suit the trial's length or sampling.
-    #[error("{0}")]
-    Windows(String),
+    #[error(transparent)]
+    Windows(#[from] LayoutError),
     #[error(transparent)]
     Pose(#[from] PoseError),
 }
@@ -145,8 +173,7 @@ pub fn prepare(
     preparation: &Preparation,
 ) -> Result<Prepared, PrepareError> {
     let s = setup.settings;
-    crate::acm::window::check_layout(&trial.time_s, s.window_s, s.hop_s)
-        .map_err(PrepareError::Windows)?;
+    crate::acm::window::check_layout(&trial.time_s, s.window_s, s.hop_s)?;
     let calibration_warnings = match &preparation.calibration {
         Some(c) => c.apply(&mut trial, setup.model),
         None => Vec::new(),
@@ -363,6 +390,7 @@ pub fn save_trial(
     let request = SaveRequest {
         input: &source.path,
         input_format: source.format,
+        input_sha256: &source.sha256,
         trial,
         pose,
         correction,
@@ -373,7 +401,7 @@ pub fn save_trial(
         output_format: output.format,
         sidecar: output.sidecar.as_deref(),
     };
-    let mut sidecar = request.sidecar()?;
+    let mut sidecar = request.sidecar();
     sidecar.calibration = calibration.cloned();
     request.save_with(sidecar)
 }

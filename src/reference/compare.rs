@@ -224,6 +224,21 @@ fn mean_abs_correlation(trial: &[Vec<f64>], reference: &Reference, time: &[f64],
     }
 }
 
+/// Why a trial cannot be scored against a reference ([`compare`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CompareError {
+    /// No series were given.
+    #[error("nothing to compare")]
+    Nothing,
+    /// The scored span (seconds of the trial) holds fewer than 3 samples.
+    #[error("the scored span {from_s}..{to_s} s holds {samples} samples; expected at least 3")]
+    ShortSpan {
+        from_s: f64,
+        to_s: f64,
+        samples: usize,
+    },
+}
+
 /// Scores `series` (`(name, trial)`, the first the uncorrected one, all on
 /// the same times) against `reference`.
 pub fn compare(
@@ -231,14 +246,15 @@ pub fn compare(
     model: &Model,
     reference: &Reference,
     opts: &CompareOptions,
-) -> Result<ReferenceReport, String> {
-    let (_, first) = series.first().ok_or("nothing to compare")?;
+) -> Result<ReferenceReport, CompareError> {
+    let (_, first) = series.first().ok_or(CompareError::Nothing)?;
     let (range, from_s, to_s) = span(first, opts);
     if range.len() < 3 {
-        return Err(format!(
-            "the scored span {from_s}..{to_s} s holds {} samples; expected at least 3",
-            range.len()
-        ));
+        return Err(CompareError::ShortSpan {
+            from_s,
+            to_s,
+            samples: range.len(),
+        });
     }
     let time = &first.time_s[range.clone()];
     let cut = |v: Vec<Vec<f64>>| -> Vec<Vec<f64>> {
@@ -324,7 +340,7 @@ pub fn trace(
     model: &Model,
     reference: &Reference,
     opts: &CompareOptions,
-) -> Result<ReferenceTrace, String> {
+) -> Result<ReferenceTrace, CompareError> {
     let report = compare(&[(String::new(), trial)], model, reference, opts)?;
     let values = channels_at(reference, &trial.time_s, report.lag_s);
     let mut joints: std::collections::BTreeMap<String, [Option<Vec<f64>>; 3]> = Default::default();

@@ -10,8 +10,8 @@ mod compare;
 mod read;
 
 pub use compare::{
-    compare, format_text, trace, AxisScore, CompareOptions, ReferenceReport, ReferenceTrace,
-    VariantScores,
+    compare, format_text, trace, AxisScore, CompareError, CompareOptions, ReferenceReport,
+    ReferenceTrace, VariantScores,
 };
 pub use read::{
     read_reference, reference_beside, write_c3d, write_csv, write_mot, REFERENCE_BESIDE,

@@ -105,13 +105,12 @@ impl Truth {
     /// Checks that `measured` pairs with this truth sample by sample: same number
     /// of samples, same times (within 1 microsecond), and every measured IMU in
     /// the truth. The error says what differs.
-    pub fn check_against(&self, measured: &Trial) -> Result<(), String> {
+    pub fn check_against(&self, measured: &Trial) -> Result<(), TruthMismatch> {
         if measured.len() != self.segments.len() {
-            return Err(format!(
-                "the truth has {} samples, the trial {}",
-                self.segments.len(),
-                measured.len()
-            ));
+            return Err(TruthMismatch::Samples {
+                truth: self.segments.len(),
+                trial: measured.len(),
+            });
         }
         if let Some((i, (a, b))) = measured
             .time_s
@@ -120,16 +119,18 @@ impl Truth {
             .enumerate()
             .find(|(_, (a, b))| (*a - *b).abs() > 1e-6)
         {
-            return Err(format!(
-                "sample {i}: the trial's time is {a} s, the truth's {b} s"
-            ));
+            return Err(TruthMismatch::Time {
+                sample: i,
+                trial_s: *a,
+                truth_s: *b,
+            });
         }
         if let Some(s) = measured
             .imus
             .iter()
             .find(|s| self.segments.imu(&s.name).is_none())
         {
-            return Err(format!("IMU '{}' has no truth", s.name));
+            return Err(TruthMismatch::Imu(s.name.clone()));
         }
         Ok(())
     }
@@ -158,6 +159,23 @@ fn stem(trial_path: &Path) -> String {
         Some(i) if i > 0 => name[..i].to_string(),
         _ => name.to_string(),
     }
+}
+
+/// How a trial and the truth beside it do not pair ([`Truth::check_against`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TruthMismatch {
+    #[error("the truth has {truth} samples, the trial {trial}")]
+    Samples { truth: usize, trial: usize },
+    /// Times of one sample further apart than 1 microsecond (seconds).
+    #[error("sample {sample}: the trial's time is {trial_s} s, the truth's {truth_s} s")]
+    Time {
+        sample: usize,
+        trial_s: f64,
+        truth_s: f64,
+    },
+    /// An IMU of the trial the truth does not have.
+    #[error("IMU '{0}' has no truth")]
+    Imu(String),
 }
 
 /// The truth files beside a trial: `(NAME.truth.csv.gz, NAME.truth.json)`.
@@ -256,6 +274,7 @@ mod tests {
             .truth
             .check_against(&short)
             .unwrap_err()
+            .to_string()
             .contains("samples"));
         let mut shifted = sim.trial.clone();
         shifted.time_s[3] += 0.001;
@@ -263,6 +282,7 @@ mod tests {
             .truth
             .check_against(&shifted)
             .unwrap_err()
+            .to_string()
             .contains("sample 3"));
         // serde_json parses floats to within an ulp, not always bit for bit.
         for imu in sim.truth.meta.misalignments.keys() {

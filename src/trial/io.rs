@@ -21,6 +21,7 @@
 //! IMU names are mapped to canonical names with [`Model::canonical_imu`]; IMUs the
 //! model does not know are kept under the name found, with a warning.
 
+use super::format::{holder, kind_of_name, Holder, Kind};
 use super::{Trial, TrialError, TrialFormat};
 use crate::model::Model;
 use crate::rotation::{canonical, euler_zyx_deg};
@@ -28,12 +29,10 @@ use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Read, Write as _};
 use std::path::{Path, PathBuf};
 
-#[cfg(test)]
-mod gyro_tests;
+mod file;
 pub(crate) mod parse;
-#[cfg(test)]
-mod tests;
 
+pub use file::TrialFile;
 use parse::{classify_csv_header, first_header, parse_header, parse_trial, LineIter};
 
 /// A cheap look at a trial file: its format and IMUs, without the samples.
@@ -51,28 +50,6 @@ pub struct TrialHeader {
 /// Largest header [`read_trial_header`] and [`detect_format`] read before giving up.
 const HEAD_LIMIT: usize = 4 << 20;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
-    Csv,
-    Sto,
-}
-
-/// `(kind, gzip)` from a file name, if it names a trial format.
-fn kind_of_name(path: &Path) -> Option<(Kind, bool)> {
-    let name = path.file_name()?.to_string_lossy().to_ascii_lowercase();
-    let (stem, gz) = match name.strip_suffix(".gz") {
-        Some(s) => (s, true),
-        None => (name.as_str(), false),
-    };
-    if stem.ends_with(".csv") && stem.len() > 4 {
-        Some((Kind::Csv, gz))
-    } else if stem.ends_with(".sto") && stem.len() > 4 {
-        Some((Kind::Sto, gz))
-    } else {
-        None
-    }
-}
-
 fn origin_of(path: &Path) -> String {
     path.display().to_string()
 }
@@ -84,26 +61,20 @@ fn name_of(origin: &str) -> String {
         .unwrap_or_else(|| origin.to_string())
 }
 
-fn kind_or_err(path: &Path) -> Result<(Kind, bool), TrialError> {
-    kind_of_name(path).ok_or_else(|| {
-        TrialError::file(
-            origin_of(path),
-            format!(
-                "unknown trial file type: expected {}",
-                super::ACCEPTED_INPUTS
-            ),
-        )
+/// What holds the trial at `path`: `None` for Xsens exports (a folder, an
+/// `.xml` mapping, a `.txt` export, or a `.csv` that starts like an MT
+/// Manager export: this one looks at the file's first bytes), else the text
+/// file's kind and compression.
+fn text_kind(path: &Path) -> Result<Option<(Kind, bool)>, TrialError> {
+    Ok(match holder(path)? {
+        Holder::Exports => None,
+        Holder::Text { kind, gzip }
+            if kind == Kind::Csv && !gzip && super::xsens_trial::is_export_file(path) =>
+        {
+            None
+        }
+        Holder::Text { kind, gzip } => Some((kind, gzip)),
     })
-}
-
-/// True when `path` names an Xsens trial: a folder, an `.xml` mapping file, or
-/// a single export (`.txt`, or a `.csv` that starts like an MT Manager export).
-fn is_xsens_path(path: &Path) -> bool {
-    path.is_dir()
-        || path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("xml") || e.eq_ignore_ascii_case("txt"))
-        || super::xsens_trial::is_export_file(path)
 }
 
 /// True when `path` is a trial the workbench lists: a trial file
@@ -141,16 +112,6 @@ pub fn folder_trials(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
         .into_iter()
         .filter(|p| !(p.is_dir() && read_by_mapping.contains(p)))
         .collect())
-}
-
-/// The bytes that identify a trial's input for the sidecar's hash: the file, or
-/// for Xsens trials the mapping followed by every export.
-pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
-    if is_xsens_path(path) {
-        super::xsens_trial::input_bytes(path)
-    } else {
-        crate::input::read_bytes(path)
-    }
 }
 
 /// True when `path`'s name is a trial file: it ends in `.csv`, `.sto`, `.csv.gz` or
@@ -224,26 +185,6 @@ fn to_text(bytes: Vec<u8>, origin: &str, kind: Kind, gzip: bool) -> Result<Strin
     })
 }
 
-/// Reads and decompresses the whole file; also a warning when the sidecar
-/// beside it describes another version of it.
-fn read_text(path: &Path, kind: Kind, gzip: bool) -> Result<(String, Option<String>), TrialError> {
-    let origin = origin_of(path);
-    let raw = crate::input::read_bytes(path).map_err(|e| cannot_read(&origin, e))?;
-    let stale = crate::sidecar::mismatch_warning(path, &raw);
-    let bytes = if gzip {
-        crate::input::gunzip_capped(&raw).map_err(|e| {
-            if e.kind() == std::io::ErrorKind::InvalidData && e.to_string().contains("more than") {
-                TrialError::file(&origin, format!("cannot read: {e}"))
-            } else {
-                bad_gzip(&origin, e)
-            }
-        })?
-    } else {
-        raw
-    };
-    Ok((to_text(bytes, &origin, kind, gzip)?, stale))
-}
-
 /// Reads only the header lines: for CSV the first non-blank line, for `.sto` up to
 /// the first non-blank line after `endheader`.
 fn read_head(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> {
@@ -293,14 +234,11 @@ fn read_head(path: &Path, kind: Kind, gzip: bool) -> Result<String, TrialError> 
 /// `_roll/_pitch/_yaw`), `*.sto` is [`TrialFormat::Sto`]; each optionally `.gz`.
 /// Reads only the first line of a CSV file.
 pub fn detect_format(path: &Path) -> Result<(TrialFormat, bool), TrialError> {
-    if is_xsens_path(path) {
-        return Ok((TrialFormat::Xsens, false));
-    }
-    let (kind, gzip) = kind_or_err(path)?;
-    match kind {
-        Kind::Sto => Ok((TrialFormat::Sto, gzip)),
-        Kind::Csv => {
-            let head = read_head(path, kind, gzip)?;
+    match text_kind(path)? {
+        None => Ok((TrialFormat::Xsens, false)),
+        Some((Kind::Sto, gzip)) => Ok((TrialFormat::Sto, gzip)),
+        Some((Kind::Csv, gzip)) => {
+            let head = read_head(path, Kind::Csv, gzip)?;
             match first_header(&head) {
                 Some(h) => Ok((classify_csv_header(h), gzip)),
                 None => Err(TrialError::at(
@@ -314,22 +252,11 @@ pub fn detect_format(path: &Path) -> Result<(TrialFormat, bool), TrialError> {
     }
 }
 
-/// Reads a trial, picking the format from the file name (`.csv`, `.sto`,
-/// optionally `.gz`) and, for CSV, the header. `Trial::name` is the file name.
+/// Reads a trial ([`TrialFile::read`], then [`TrialFile::trial`]): the
+/// format from the file name (`.csv`, `.sto`, optionally `.gz`; Xsens
+/// exports) and, for CSV, the header. `Trial::name` is the file name.
 pub fn read_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
-    if is_xsens_path(path) {
-        return super::xsens_trial::read_xsens_trial(path, model);
-    }
-    let (kind, gzip) = kind_or_err(path)?;
-    let (text, stale) = read_text(path, kind, gzip)?;
-    let format = match kind {
-        Kind::Sto => TrialFormat::Sto,
-        Kind::Csv => first_header(&text).map_or(TrialFormat::QuatCsv, classify_csv_header),
-    };
-    let origin = origin_of(path);
-    let mut trial = parse_trial(&text, &origin, &name_of(&origin), format, model)?;
-    trial.warnings.extend(stale);
-    Ok(trial)
+    TrialFile::read(path)?.trial(model)
 }
 
 /// Reads a trial from text in `format`; `origin` names the file in errors, and its
@@ -417,25 +344,56 @@ impl TrialHead {
     /// Reads the header of the trial at `path` (the first lines only).
     pub fn read(path: &Path) -> Result<TrialHead, TrialError> {
         let origin = origin_of(path);
-        if is_xsens_path(path) {
+        let Some((kind, gzip)) = text_kind(path)? else {
             let names = super::xsens_trial::imu_names(path)?;
-            return Ok(TrialHead {
-                origin,
-                gzip: false,
-                lines: HeadLines::Xsens(names),
-            });
-        }
-        let (kind, gzip) = kind_or_err(path)?;
+            return Ok(TrialHead::of_exports(origin, names));
+        };
         let head = read_head(path, kind, gzip)?;
         let format = match kind {
             Kind::Sto => TrialFormat::Sto,
             Kind::Csv => first_header(&head).map_or(TrialFormat::QuatCsv, classify_csv_header),
         };
-        Ok(TrialHead {
+        Ok(TrialHead::of_text(origin, gzip, format, &head))
+    }
+
+    /// The header lines `head` of a CSV or `.sto` file in `format`.
+    fn of_text(origin: String, gzip: bool, format: TrialFormat, head: &str) -> TrialHead {
+        TrialHead {
             origin,
             gzip,
-            lines: HeadLines::Text(format, head),
-        })
+            lines: HeadLines::Text(format, head.to_string()),
+        }
+    }
+
+    /// The sensor names (before aliases) of a trial of Xsens exports.
+    fn of_exports(origin: String, names: Vec<String>) -> TrialHead {
+        TrialHead {
+            origin,
+            gzip: false,
+            lines: HeadLines::Xsens(names),
+        }
+    }
+
+    /// The trial's format.
+    pub fn format(&self) -> TrialFormat {
+        match &self.lines {
+            HeadLines::Text(format, _) => *format,
+            HeadLines::Xsens(_) => TrialFormat::Xsens,
+        }
+    }
+
+    /// Whether the file is gzip-compressed.
+    pub fn gzip(&self) -> bool {
+        self.gzip
+    }
+
+    /// The built-in model that fits the trial best (from its header only):
+    /// the one that recognises most of its IMUs, and among those the one
+    /// with fewest IMUs the trial lacks (so an 8-sensor OpenSense trial gets
+    /// `opensense_lower`, not the 12-IMU `opensim`); the first built-in model
+    /// when none recognises any.
+    pub fn detect_model(&self) -> Model {
+        super::best_model(Some(self))
     }
 
     /// The header as `model` names its IMUs, checked as [`read_trial`] would check it.
@@ -467,10 +425,16 @@ pub fn write_trial(
         path: origin.clone(),
         message,
     };
-    if format == TrialFormat::Xsens {
-        return Err(refused(
-            "cannot write Xsens exports: expected quat-csv, euler-csv or sto".into(),
-        ));
+    if !format.row().writable {
+        let writable: Vec<&str> = (super::format::FORMATS.iter())
+            .filter(|r| r.writable)
+            .map(|r| r.name)
+            .collect();
+        return Err(refused(format!(
+            "cannot write {}: expected {}",
+            format.row().help,
+            writable.join(", ")
+        )));
     }
     if let Some(bad) = trial.imus.iter().find(|s| {
         s.gyro
@@ -496,22 +460,15 @@ pub fn write_trial(
             trial.time_s.len()
         )));
     }
-    let (kind, gzip) = match kind_of_name(path) {
-        Some((k, gz)) => (Some(k), gz),
-        None => (
-            None,
-            path.to_string_lossy().to_ascii_lowercase().ends_with(".gz"),
-        ),
+    let gzip = match kind_of_name(path) {
+        Some((_, gz)) => gz,
+        None => path.to_string_lossy().to_ascii_lowercase().ends_with(".gz"),
     };
-    let wanted = if format == TrialFormat::Sto {
-        Kind::Sto
-    } else {
-        Kind::Csv
-    };
-    if kind.is_some_and(|k| k != wanted) {
+    let named = kind_of_name(path).map(|(k, _)| if k == Kind::Sto { "sto" } else { "csv" });
+    if named.is_some_and(|ext| ext != format.extension()) {
         return Err(refused(format!(
             "cannot write {format:?} to this file name: expected a name ending in .{}",
-            if wanted == Kind::Sto { "sto" } else { "csv" }
+            format.extension()
         )));
     }
     let text = trial_to_string(trial, format);
@@ -600,3 +557,6 @@ pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
     }
     out
 }
+
+#[cfg(test)]
+mod tests;

@@ -11,6 +11,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 mod error;
+pub mod format;
 pub mod glitch;
 mod io;
 pub mod mapping;
@@ -95,17 +96,6 @@ pub enum TrialFormat {
     Xsens,
 }
 
-impl TrialFormat {
-    /// The format a corrected trial is written in by default: the input's own,
-    /// or `.sto` (what OpenSense makes of them) for Xsens exports.
-    pub fn output_default(self) -> TrialFormat {
-        match self {
-            TrialFormat::Xsens => TrialFormat::Sto,
-            f => f,
-        }
-    }
-}
-
 impl Trial {
     /// Number of samples.
     pub fn len(&self) -> usize {
@@ -180,18 +170,20 @@ impl Trial {
     }
 }
 
-/// The built-in model that fits the trial at `path` best (from its header or
-/// mapping only): the one that recognises most of its IMUs, and among those the
-/// one with fewest IMUs the trial lacks (so an 8-sensor OpenSense trial gets
-/// `opensense_lower`, not the 12-IMU `opensim`); the first built-in model when
-/// none recognises any. The header is read from disk once.
+/// The built-in model that fits the trial at `path` best
+/// ([`TrialHead::detect_model`]; the first built-in model when the header
+/// cannot be read). The header is read from disk once.
 pub fn detect_model(path: &std::path::Path) -> crate::model::Model {
+    best_model(TrialHead::read(path).ok().as_ref())
+}
+
+/// [`TrialHead::detect_model`] of `head`, or the first built-in model.
+fn best_model(head: Option<&TrialHead>) -> crate::model::Model {
     use crate::model::{Model, BUILTIN_MODELS};
-    let head = TrialHead::read(path).ok();
     let mut best: Option<((usize, usize), Model)> = None;
     for (name, _) in BUILTIN_MODELS {
         let model = Model::builtin(name).expect("built-in model is valid");
-        let known = (head.as_ref())
+        let known = head
             .and_then(|h| h.header(&model).ok())
             .map(|h| h.imus.iter().filter(|i| model.imus.contains(i)).count())
             .unwrap_or(0);

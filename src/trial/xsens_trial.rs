@@ -24,6 +24,9 @@ use std::path::{Path, PathBuf};
 pub struct XsensSource {
     /// The mapping used, with its path.
     pub mapping: Option<(PathBuf, Mapping)>,
+    /// The mapping's text as read (empty without a mapping): the first part
+    /// of what the trial's hash covers.
+    pub mapping_text: String,
     /// Export files with the IMU name each stands for (as found, before aliases).
     pub files: Vec<(PathBuf, String)>,
 }
@@ -71,6 +74,11 @@ fn starts_like_export(text: &str) -> bool {
     first.trim_start().starts_with("//")
         || lower.contains("packetcounter")
         || lower.contains("packet counter")
+}
+
+/// [`is_export_file`]'s look at a file, on its bytes: they start like an export.
+pub(crate) fn starts_like_export_bytes(bytes: &[u8]) -> bool {
+    starts_like_export(&String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]))
 }
 
 /// The serial an export's file name ends in (after its last `_`).
@@ -186,7 +194,8 @@ fn files_of_mapping(
 /// Reads the mapping at `xml` and finds its exports.
 fn resolve_mapping(xml: &Path) -> Result<XsensSource, TrialError> {
     let origin = xml.display().to_string();
-    let mapping = parse_mapping(&read_text(xml)?, &origin)?;
+    let mapping_text = read_text(xml)?;
+    let mapping = parse_mapping(&mapping_text, &origin)?;
     check_export_names(xml, &mapping)?;
     let folder = export_folder(xml, &mapping).ok_or_else(|| {
         let s = &mapping.sensors[0];
@@ -203,6 +212,7 @@ fn resolve_mapping(xml: &Path) -> Result<XsensSource, TrialError> {
     let files = files_of_mapping(xml, &mapping, &folder)?;
     Ok(XsensSource {
         mapping: Some((xml.to_path_buf(), mapping)),
+        mapping_text,
         files,
     })
 }
@@ -268,6 +278,7 @@ pub fn resolve(path: &Path) -> Result<XsensSource, TrialError> {
     }
     Ok(XsensSource {
         mapping: None,
+        mapping_text: String::new(),
         files,
     })
 }
@@ -286,7 +297,8 @@ fn single_export(path: &Path) -> XsensSource {
         .flat_map(|d| sorted_entries(&d))
         .filter(|p| is_mapping_file(p))
         .find_map(|xml| {
-            let m = parse_mapping(&std::fs::read_to_string(&xml).ok()?, "").ok()?;
+            let text = std::fs::read_to_string(&xml).ok()?;
+            let m = parse_mapping(&text, "").ok()?;
             let s = m.sensors.iter().find(|s| {
                 let stem = format!("{}{}", m.trial_prefix, s.file_suffix);
                 [".txt", ".csv"]
@@ -294,15 +306,18 @@ fn single_export(path: &Path) -> XsensSource {
                     .iter()
                     .any(|n| file.as_deref() == Some(n.as_str()))
             })?;
-            Some((xml, s.name_in_model.clone(), m))
+            let name = s.name_in_model.clone();
+            Some((xml, name, m, text))
         });
     match named {
-        Some((xml, name, m)) => XsensSource {
+        Some((xml, name, m, text)) => XsensSource {
             mapping: Some((xml, m)),
+            mapping_text: text,
             files: vec![(path.to_path_buf(), name)],
         },
         None => XsensSource {
             mapping: None,
+            mapping_text: String::new(),
             files: vec![(path.to_path_buf(), serial_of(path))],
         },
     }
@@ -313,38 +328,37 @@ pub fn imu_names(path: &Path) -> Result<Vec<String>, TrialError> {
     Ok(resolve(path)?.files.into_iter().map(|(_, n)| n).collect())
 }
 
-/// The bytes that identify the trial's input (mapping, then every export in order),
-/// for the sidecar's hash.
-pub fn input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
-    let source = resolve(path).map_err(|e| std::io::Error::other(e.to_string()))?;
-    let mut out = Vec::new();
-    if let Some((xml, _)) = &source.mapping {
-        out.extend(crate::input::read_bytes(xml)?);
-    }
-    for (f, _) in &source.files {
-        out.extend(crate::input::read_bytes(f)?);
-    }
-    Ok(out)
+/// Reads an Xsens trial (mapping XML, folder or single export): exports
+/// parsed, aligned on the packet counter, rotated by the mapping's
+/// `sensor_to_opensim_rotations` if any, IMU names mapped through `model`'s
+/// aliases. `Trial::name` is the path's last component.
+pub fn read_xsens_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
+    super::TrialFile::read(path)?.trial(model)
 }
 
-/// Reads an Xsens trial (mapping XML or folder): exports parsed, aligned on the
-/// packet counter, rotated by the mapping's `sensor_to_opensim_rotations` if any,
-/// IMU names mapped through `model`'s aliases. `Trial::name` is the path's last component.
-pub fn read_xsens_trial(path: &Path, model: &Model) -> Result<Trial, TrialError> {
-    let source = resolve(path)?;
-    let single = path.is_file() && source.files.len() == 1 && !is_mapping_file(path);
+/// The trial of the exports of `source` (read as `exports`, in the order of
+/// its files) named by `path`.
+pub(crate) fn trial_of_exports(
+    path: &Path,
+    source: &XsensSource,
+    exports: &[Vec<u8>],
+    model: &Model,
+) -> Result<Trial, TrialError> {
+    let single = source.files.len() == 1 && source.files[0].0 == path;
     if !single
         && source
             .files
             .iter()
             .all(|(_, n)| model.canonical_imu(n).is_none())
     {
-        return Err(no_imu_error(path, &source, model));
+        return Err(no_imu_error(path, source, model));
     }
-    let mut exports = Vec::with_capacity(source.files.len());
-    for (f, name) in &source.files {
+    let mut parsed = Vec::with_capacity(source.files.len());
+    for ((f, name), bytes) in source.files.iter().zip(exports) {
         let origin = f.display().to_string();
-        exports.push((name.clone(), parse_export(&read_text(f)?, &origin)?));
+        let text = crate::input::str_of(bytes)
+            .map_err(|e| TrialError::file(&origin, format!("cannot read: {}", e.error)))?;
+        parsed.push((name.clone(), parse_export(text, &origin)?));
     }
     let rotation = source
         .mapping
@@ -355,7 +369,7 @@ pub fn read_xsens_trial(path: &Path, model: &Model) -> Result<Trial, TrialError>
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string());
-    assemble(&name, exports, rotation, model)
+    assemble(&name, parsed, rotation, model)
 }
 
 /// The error for a folder or mapping none of whose sensors is an IMU of
@@ -547,6 +561,36 @@ pub(crate) fn assemble(
 ) -> Result<Trial, TrialError> {
     let rate = common_rate(&exports)?;
     align_wraps(&mut exports);
+    let (start, end, kept) = shared_packets(&exports)?;
+    let mut warnings: Vec<String> = frame_warning(&exports).into_iter().collect();
+    warnings.extend(coverage_warnings(&exports, start, end, kept.len()));
+    let imus = imu_series(&exports, &kept, rotation, model, &mut warnings)?;
+    let time_s: Vec<f64> = kept
+        .iter()
+        .map(|(c, _)| (c - start) as f64 / rate)
+        .collect();
+    if let Err((i, message)) = crate::trial::timing::check_time_axis(&time_s) {
+        return Err(TrialError::file(
+            exports[0].1.origin.clone(),
+            format!("packet {}: {message}", kept[i].0),
+        ));
+    }
+    Ok(Trial {
+        name: name.to_string(),
+        time_s,
+        imus,
+        warnings,
+    })
+}
+
+/// A packet every export recorded: its counter and its index in each export.
+type SharedPacket = (u64, Vec<usize>);
+
+/// The packets every export recorded, between the latest first counter
+/// (`start`) and the earliest last one (`end`); an error when there are none.
+fn shared_packets(
+    exports: &[(String, XsensExport)],
+) -> Result<(u64, u64, Vec<SharedPacket>), TrialError> {
     let start = exports
         .iter()
         .map(|(_, e)| e.counters[0])
@@ -563,10 +607,9 @@ pub(crate) fn assemble(
             format!("the sensors share no packet: their counters cover {start} and {end} apart; expected exports of one recording"),
         ));
     }
-    let mut warnings: Vec<String> = frame_warning(&exports).into_iter().collect();
     // Indices, per file, of the packets every file has.
     let mut pos = vec![0usize; exports.len()];
-    let mut kept: Vec<(u64, Vec<usize>)> = Vec::new();
+    let mut kept: Vec<SharedPacket> = Vec::new();
     for &c in exports[0]
         .1
         .counters
@@ -592,6 +635,18 @@ pub(crate) fn assemble(
             format!("the sensors share no packet between counters {start} and {end}: expected exports of one recording with at least one packet every sensor recorded"),
         ));
     }
+    Ok((start, end, kept))
+}
+
+/// What the alignment left out: packets before `start` or after `end` some
+/// sensor recorded (`kept` samples remain), and each sensor's missing runs.
+fn coverage_warnings(
+    exports: &[(String, XsensExport)],
+    start: u64,
+    end: u64,
+    kept: usize,
+) -> Vec<String> {
+    let mut warnings = Vec::new();
     let firsts: Vec<u64> = exports.iter().map(|(_, e)| e.counters[0]).collect();
     let lasts: Vec<u64> = exports
         .iter()
@@ -608,13 +663,12 @@ pub(crate) fn assemble(
     };
     if spread(&firsts) || spread(&lasts) {
         warnings.push(format!(
-            "sensors start at packet {} and end at packet {}: kept packets {start}..{end} ({} samples), which every sensor recorded",
+            "sensors start at packet {} and end at packet {}: kept packets {start}..{end} ({kept} samples), which every sensor recorded",
             range(&firsts),
             range(&lasts),
-            kept.len()
         ));
     }
-    for (imu, e) in &exports {
+    for (imu, e) in exports {
         let inside: Vec<u64> = e
             .counters
             .iter()
@@ -637,6 +691,19 @@ pub(crate) fn assemble(
             ));
         }
     }
+    warnings
+}
+
+/// Each export's orientations (turned by `rotation`) and gyroscope readings
+/// at the `kept` packets, named through `model`'s aliases; warnings for
+/// IMUs the model lacks and for renormalised quaternions.
+fn imu_series(
+    exports: &[(String, XsensExport)],
+    kept: &[SharedPacket],
+    rotation: Option<Quat>,
+    model: &Model,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<ImuSeries>, TrialError> {
     let mut imus: Vec<ImuSeries> = Vec::with_capacity(exports.len());
     for (k, (found, e)) in exports.iter().enumerate() {
         let canonical = match model.canonical_imu(found) {
@@ -681,22 +748,7 @@ pub(crate) fn assemble(
             .map(|g| kept.iter().map(|(_, idx)| g[idx[k]]).collect());
         imus.push(ImuSeries::new(canonical, orientation).with_gyro(gyro));
     }
-    let time_s: Vec<f64> = kept
-        .iter()
-        .map(|(c, _)| (c - start) as f64 / rate)
-        .collect();
-    if let Err((i, message)) = crate::trial::timing::check_time_axis(&time_s) {
-        return Err(TrialError::file(
-            exports[0].1.origin.clone(),
-            format!("packet {}: {message}", kept[i].0),
-        ));
-    }
-    Ok(Trial {
-        name: name.to_string(),
-        time_s,
-        imus,
-        warnings,
-    })
+    Ok(imus)
 }
 
 fn file_name(origin: &str) -> String {

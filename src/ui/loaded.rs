@@ -4,7 +4,7 @@
 
 use crate::metrics::JointFigures;
 use crate::model::Model;
-use crate::trial::{Trial, TrialFormat};
+use crate::trial::Trial;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -35,8 +35,9 @@ impl AngleCache {
 pub struct Loaded {
     pub trial: Trial,
     pub model: Model,
-    pub format: TrialFormat,
-    pub gzip: bool,
+    /// Where the trial was read from: path, format, compression and the
+    /// hash its saved corrections' sidecars record.
+    pub source: crate::correct::pipeline::Source,
     /// True segment orientations when a truth sits beside the trial.
     pub truth: Option<Trial>,
     /// Why the truth beside the trial could not be used.

@@ -32,10 +32,4 @@ pub mod workbench;
 pub use screens::views;
 
 #[cfg(test)]
-mod flows_tests;
-#[cfg(test)]
-mod layers_tests;
-#[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod views_tests;

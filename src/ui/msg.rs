@@ -47,7 +47,6 @@ pub enum Effect {
     /// Save a variant of a trial.
     SaveVariant {
         file: String,
-        path: PathBuf,
         loaded: Arc<Loaded>,
         correction: Arc<Correction>,
         limits: LimitTable,

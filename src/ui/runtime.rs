@@ -9,12 +9,8 @@ use super::jobs::{self, list_trials, load_limits, read_limits_on_disk};
 use super::render::render;
 use super::term::{BasicColours, Caps};
 use super::theme::Theme;
-use crate::trial::{is_trial_file, is_trial_path};
-
-/// An `.xml` name (a mapping that may just have been removed).
-fn is_xml(p: &Path) -> bool {
-    crate::file_names::is_mapping_name(p)
-}
+use crate::trial::format::could_name_trial;
+use crate::trial::is_trial_path;
 use crossbeam_channel::{unbounded, Receiver, Sender};
 use notify::RecursiveMode;
 use notify_debouncer_full::{new_debouncer, new_debouncer_opt, DebounceEventResult};
@@ -224,7 +220,7 @@ fn watch_trials(dir: &Path, poll: Option<Duration>, tx: Sender<Event>) -> Option
     watch_folder(dir, poll, move |paths| {
         let names: BTreeSet<String> = paths
             .iter()
-            .filter(|p| is_trial_file(p) || is_xml(p) || p.is_dir())
+            .filter(|p| could_name_trial(p))
             .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
             .collect();
         for name in names {

@@ -2,6 +2,10 @@
 //! and a no-panic test at tiny sizes. Background work runs through
 //! [`SyncRunner`]; nothing sleeps.
 
+mod flows;
+mod layers;
+mod views;
+
 use super::app::{update, App, Msg, Overlay};
 use super::headless::{buffer_ansi, draw, load_app, show, write_demo_folder, Show, SCREENS};
 use super::jobs::SyncRunner;

@@ -2,7 +2,7 @@
 //! paths (`crate::a::b`, `super::x`, `acm_workbench::a`) of each file: which
 //! module names which. Test modules are left out (a test may drive anything
 //! above it). Shared by the core's layering test (`tests/module_layers.rs`)
-//! and the workbench's (`src/ui/layers_tests.rs`).
+//! and the workbench's (`src/ui/tests/layers.rs`).
 
 #![allow(dead_code)]
 
@@ -34,13 +34,38 @@ pub fn module_of(root: &Path, file: &Path) -> String {
     parts.join("::")
 }
 
-/// The source without its test module and comments.
+/// The source without its test items (each `#[cfg(test)]` item: a `mod x;`
+/// line or a braced block, wherever it stands) and comments.
 pub fn code_of(text: &str) -> String {
-    let code = text.split("#[cfg(test)]").next().unwrap_or("");
-    code.lines()
-        .filter(|l| !l.trim_start().starts_with("//"))
-        .collect::<Vec<_>>()
-        .join("\n")
+    let braces = |l: &str| l.matches('{').count() as i64 - l.matches('}').count() as i64;
+    let mut out = vec![];
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        if line.trim() == "#[cfg(test)]" {
+            let (mut depth, mut opened) = (0, false);
+            for item in lines.by_ref() {
+                depth += braces(item);
+                opened |= item.contains('{');
+                let ends = if opened {
+                    depth <= 0
+                } else {
+                    item.trim_end().ends_with(';')
+                };
+                if ends {
+                    break;
+                }
+            }
+        } else if !line.trim_start().starts_with("//") {
+            out.push(line);
+        }
+    }
+    out.join("\n")
+}
+
+#[test]
+fn test_items_are_left_out_wherever_they_stand() {
+    let text = "use crate::a;\n#[cfg(test)]\nmod tests;\nuse crate::b;\n#[cfg(test)]\nfn f() {\n    crate::c();\n}\n// crate::d\nuse crate::e;\n#[cfg(test)]\nmod t {\n    use crate::f;\n}\n";
+    assert_eq!(code_of(text), "use crate::a;\nuse crate::b;\nuse crate::e;");
 }
 
 fn is_path_char(c: char) -> bool {
@@ -103,14 +128,14 @@ pub fn paths_after(code: &str, prefix: &str) -> Vec<String> {
 }
 
 /// The modules of the files under `src/<under>` (all of `src` for ""), by
-/// module path, test modules left out.
+/// module path, test modules (`tests` and its children) left out.
 pub fn modules(src: &Path, under: &str) -> BTreeMap<String, PathBuf> {
     let mut files = vec![];
     rust_files(&src.join(under), &mut files);
     files
         .iter()
         .map(|f| (module_of(src, f), f.clone()))
-        .filter(|(m, _)| !m.ends_with("tests") && m != "lib" && m != "main")
+        .filter(|(m, _)| !m.split("::").any(|p| p == "tests") && m != "lib" && m != "main")
         .collect()
 }
 

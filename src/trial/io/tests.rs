@@ -1,5 +1,7 @@
 //! Tests of trial reading and writing: round trips, malformed input, names.
 
+mod gyro;
+
 use super::*;
 use crate::rotation::{angle_between_deg, quat_from_euler_zyx_deg, quat_from_wxyz, Quat};
 use crate::trial::ImuSeries;

@@ -17,7 +17,7 @@ use crate::model::Model;
 use crate::sidecar::default_output;
 use crate::simulate::truth::load_truth_beside;
 use crate::trial::glitch::glitches;
-use crate::trial::{detect_format, detect_model, read_trial, TrialError};
+use crate::trial::TrialError;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -90,29 +90,30 @@ pub fn load_trial(
         .to_string()
     };
     let result = (|| {
-        let model = model.cloned().unwrap_or_else(|| detect_model(path));
-        let (format, gzip) = detect_format(path).map_err(shown)?;
-        let mut trial = read_trial(path, &model).map_err(shown)?;
+        let input = pipeline::read(path).map_err(shown)?;
+        let model = model.cloned().unwrap_or_else(|| input.detect_model());
+        let pipeline::LoadedTrial { source, mut trial } =
+            pipeline::load_file(&input, &model).map_err(shown)?;
+        drop(input);
         trial.name = file.to_string();
         let (truth, truth_error) = match load_truth_beside(path, &model) {
             None => (None, None),
             Some(Ok(t)) => match t.check_against(&trial) {
                 Ok(()) => (Some(t.segments), None),
-                Err(m) => (None, Some(m)),
+                Err(m) => (None, Some(m.to_string())),
             },
             Some(Err(e)) => (None, Some(shown(e))),
         };
         let before = trial_figures(&trial, None, truth.as_ref(), &model, limits);
         let (reference, reference_error) = reference_beside(path, &trial, &model);
         let glitches = glitches(&trial, glitch_deg);
-        let on_disk = saved_outputs(path, format.output_default(), gzip);
+        let on_disk = saved_outputs(&source);
         Ok(Arc::new(Loaded {
             on_disk,
             glitches,
             trial,
             model,
-            format,
-            gzip,
+            source,
             truth,
             truth_error,
             reference,
@@ -142,24 +143,23 @@ fn reference_beside(
     };
     let traced = read_reference(&file, model)
         .map_err(|e| e.to_string())
-        .and_then(|r| trace(trial, model, &r, &CompareOptions::default()));
+        .and_then(|r| {
+            trace(trial, model, &r, &CompareOptions::default()).map_err(|e| e.to_string())
+        });
     match traced {
         Ok(t) => (Some(Arc::new(t)), None),
         Err(e) => (None, Some(format!("reference: {e}"))),
     }
 }
 
-/// The corrected outputs of `input` on disk whose sidecars record this very
-/// input (by its hash), by variant: what an earlier session saved.
-pub fn saved_outputs(
-    input: &Path,
-    format: crate::trial::TrialFormat,
-    gzip: bool,
-) -> std::collections::BTreeMap<Variant, SavedOutput> {
+/// The corrected outputs of the trial read from `source` on disk whose
+/// sidecars record this very input (by its hash), by variant: what an
+/// earlier session saved.
+pub fn saved_outputs(source: &Source) -> std::collections::BTreeMap<Variant, SavedOutput> {
     let mut found = std::collections::BTreeMap::new();
-    let mut hash = None;
+    let input = &source.path;
     for v in Variant::ALL {
-        let output = default_output(input, v, format, gzip);
+        let output = default_output(input, v, source.format.output_default(), source.gzip);
         let side = crate::sidecar::sidecar_path(&output);
         if !output.is_file() || !side.is_file() {
             continue;
@@ -167,12 +167,7 @@ pub fn saved_outputs(
         let Ok(record) = crate::sidecar::Sidecar::load(&side) else {
             continue;
         };
-        let hash = hash.get_or_insert_with(|| {
-            crate::trial::input_bytes(input)
-                .map(|b| crate::sidecar::sha256_hex(&b))
-                .unwrap_or_default()
-        });
-        if record.variant != v || record.input.sha256 != *hash {
+        if record.variant != v || record.input.sha256 != source.sha256 {
             continue;
         }
         let shown = input
@@ -204,7 +199,8 @@ pub fn run_job(job: &RunJob, cancel: &AtomicBool, progress: &(dyn Fn(u8) + Sync)
             settings: &job.settings,
         };
         let s = &job.settings;
-        crate::acm::window::check_layout(&l.trial.time_s, s.window_s, s.hop_s)?;
+        crate::acm::window::check_layout(&l.trial.time_s, s.window_s, s.hop_s)
+            .map_err(|e| e.to_string())?;
         let report = |done: usize, total: usize| progress((done * 100 / total.max(1)) as u8);
         let control = RunControl {
             cancel: Some(cancel),
@@ -255,17 +251,12 @@ pub fn run_job(job: &RunJob, cancel: &AtomicBool, progress: &(dyn Fn(u8) + Sync)
 pub fn save_variant(
     dir: &Path,
     file: &str,
-    path: &Path,
     loaded: &Loaded,
     correction: &Correction,
     limits: &LimitTable,
     limits_source: &str,
 ) -> Msg {
-    let source = Source {
-        path: path.to_path_buf(),
-        format: loaded.format,
-        gzip: loaded.gzip,
-    };
+    let source = &loaded.source;
     let output = source.default_output(correction.variant, None);
     let settings = correction.settings;
     let setup = Setup {
@@ -280,7 +271,7 @@ pub fn save_variant(
         .map(Path::to_path_buf)
         .unwrap_or_else(|_| output.path.clone());
     let saved = pipeline::save_trial(
-        &source,
+        source,
         &loaded.trial,
         loaded.pose.as_ref(),
         correction,
@@ -331,7 +322,6 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
         }
         Effect::SaveVariant {
             file,
-            path,
             loaded,
             correction,
             limits,
@@ -339,7 +329,6 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
         } => vec![save_variant(
             app_dir,
             &file,
-            &path,
             &loaded,
             &correction,
             &limits,

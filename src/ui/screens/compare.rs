@@ -286,7 +286,6 @@ pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
             e.saving = Some(v);
             let effect = Effect::SaveVariant {
                 file: file.clone(),
-                path: e.path.clone(),
                 loaded,
                 correction: r.correction.clone(),
                 limits,

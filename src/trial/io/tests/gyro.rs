@@ -1,8 +1,8 @@
 //! Gyroscope columns `<imu>_gx,<imu>_gy,<imu>_gz` (rad/s, sensor frame) in the
 //! CSV formats: round trips, where they may stand, and located errors.
 
-use super::tests::{check, infant, random_trial};
-use super::*;
+use super::super::*;
+use super::{check, infant, random_trial};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

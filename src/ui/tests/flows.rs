@@ -2,12 +2,12 @@
 //! disk, saved outputs found again at start-up, a choice that stays with its
 //! trial. Driven through `update` and [`SyncRunner`]; nothing sleeps.
 
-use super::app::{update, Msg, Overlay};
-use super::headless::buffer_text;
-use super::jobs::{read_limits_on_disk, SyncRunner};
-use super::msg::Screen;
-use super::tests::{key, keys, terminal, Fixture};
+use super::{key, keys, terminal, Fixture};
 use crate::acm::Variant;
+use crate::ui::app::{update, Msg, Overlay};
+use crate::ui::headless::buffer_text;
+use crate::ui::jobs::{read_limits_on_disk, SyncRunner};
+use crate::ui::msg::Screen;
 use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 fn ctrl_c() -> Msg {

@@ -1,13 +1,13 @@
 //! Flows and snapshots of the analysis views (scatter, globe, applied
 //! correction, stick figure), driven through `update` with fixed data.
 
-use super::app::{update, App, Msg};
-use super::jobs::SyncRunner;
-use super::msg::Screen;
-use super::tests::{key, keys, snap, terminal, Fixture};
-use super::views::{ViewKind, CLASS_COLOURS, PLAY_STEP_S};
+use super::{key, keys, snap, terminal, Fixture};
 use crate::simulate::{simulate, SimConfig};
 use crate::trial::{write_trial, TrialFormat};
+use crate::ui::app::{update, App, Msg};
+use crate::ui::jobs::SyncRunner;
+use crate::ui::msg::Screen;
+use crate::ui::views::{ViewKind, CLASS_COLOURS, PLAY_STEP_S};
 use ratatui::crossterm::event::KeyCode;
 use ratatui::style::Color;
 
@@ -115,7 +115,7 @@ fn stick_figure_scrubs_and_plays() {
     key(&mut app, KeyCode::Left);
     assert_eq!(app.views.time_s, 4.0);
     keys(&mut app, "p");
-    assert!(app.views.playing && super::app::wants_ticks(&app));
+    assert!(app.views.playing && crate::ui::app::wants_ticks(&app));
     for _ in 0..10 {
         update(&mut app, Msg::Tick);
     }

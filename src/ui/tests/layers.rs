@@ -3,7 +3,7 @@
 //! navigation), and no two modules of the workbench import each other
 //! through any chain. Test modules are left out: they may drive the router.
 
-#[path = "../../tests/module_graph/mod.rs"]
+#[path = "../../../tests/module_graph/mod.rs"]
 mod module_graph;
 
 use module_graph::{code_of, find_cycle, module_of, paths_after, related};
