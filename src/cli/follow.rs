@@ -168,8 +168,7 @@ fn wait_for_header(
 pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     let input = &args.input;
     let name = input.display().to_string();
-    let lower = name.to_ascii_lowercase();
-    if !lower.ends_with(".csv") {
+    if !acm_workbench::file_names::is_plain_csv_name(input) {
         anyhow::bail!(
             "{name}: acmw follow reads a growing canonical or Euler CSV (a name ending in .csv, not compressed); `acmw correct` reads the other formats once they are complete"
         );
