@@ -490,7 +490,8 @@ fn outline(points: Vec<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
     if points.windows(2).all(|w| w[0].0 != w[1].0) {
         return vec![points];
     }
-    let (mut lower, mut upper): (Vec<(f64, f64)>, Vec<(f64, f64)>) = (vec![], vec![]);
+    let mut lower: Vec<(f64, f64)> = vec![];
+    let mut upper: Vec<(f64, f64)> = vec![];
     for p in points {
         match lower.last_mut() {
             Some(l) if l.0 == p.0 => {
