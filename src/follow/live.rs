@@ -80,7 +80,7 @@ struct Request {
 struct Answer {
     generation: u64,
     solved: Solved,
-    solution: Option<Solution>,
+    solution: Option<(Solution, Arc<Trial>)>,
 }
 
 /// A trial read as it grows: rows are added as their lines land
@@ -97,6 +97,8 @@ pub struct Follower {
     trial: Option<Trial>,
     next_point: usize,
     solution: Solution,
+    /// The samples the newest solution was solved on, as it corrected them.
+    solved_trial: Option<Arc<Trial>>,
     generation: u64,
     reached_until: bool,
     /// Samples of the newest solve asked for, and of the newest answered, in
@@ -133,6 +135,7 @@ impl Follower {
             trial: None,
             next_point: 0,
             solution: Solution::identity(0),
+            solved_trial: None,
             generation: 0,
             reached_until: false,
             asked: 0,
@@ -152,6 +155,7 @@ impl Follower {
         self.trial = None;
         self.next_point = 0;
         self.solution = Solution::identity(0);
+        self.solved_trial = None;
         self.generation += 1;
         self.reached_until = false;
         self.asked = 0;
@@ -171,6 +175,14 @@ impl Follower {
     /// The solution new rows are corrected with.
     pub fn solution(&self) -> &Solution {
         &self.solution
+    }
+
+    /// The samples the newest solution was solved on (a prefix of the
+    /// trial), corrected by that solve as `acmw correct` corrects a trial of
+    /// those samples; `None` before the first solve. Samples after it are
+    /// corrected by extrapolation ([`Follower::corrected`]).
+    pub fn solved_trial(&self) -> Option<&Arc<Trial>> {
+        self.solved_trial.as_ref()
     }
 
     /// Whether a row past `until_s` was seen: the trial is complete.
@@ -284,9 +296,10 @@ impl Follower {
         }
         // The solver skips requests that queued behind a newer one.
         self.answered = self.answered.max(a.solved.samples);
-        if let Some(s) = a.solution {
+        if let Some((s, corrected)) = a.solution {
             if s.samples >= self.solution.samples {
                 self.solution = s;
+                self.solved_trial = Some(corrected);
             }
         }
         out.push(a.solved);
@@ -387,7 +400,10 @@ fn solver(
             .map_err(|e| e.to_string())
             .and_then(|p| {
                 pipeline::correct(&p.trial, setup, config.variant, &control)
-                    .map(|c| Solution::new(&p.trial, &c, config.extrapolation))
+                    .map(|c| {
+                        let s = Solution::new(&p.trial, &c, config.extrapolation);
+                        (s, Arc::new(c.corrected))
+                    })
                     .map_err(|_| "cancelled".to_string())
             });
         let (solution, error) = match result {

@@ -10,14 +10,17 @@ use super::screens::calibration::CalibState;
 use super::screens::histogram::HistogramState;
 use super::screens::views::ViewsState;
 use super::screens::{calibration, compare, histogram, limits, trial, trials, views};
-use super::workbench::{AngleCache, LimitsState, LoadState, TrialEntry, VariantResult, Workbench};
+use super::workbench::{
+    AngleCache, LimitsState, LoadState, TrialEntry, VariantResult, Workbench, FIRST_EDIT_COL,
+    LAST_COL,
+};
 use crate::limits::{LimitTable, SettingsFile};
 use ratatui::crossterm::event::{
-    KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEventKind,
+    KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
 };
 use std::path::PathBuf;
 
-pub use super::msg::{Effect, Msg, RunJob, Screen};
+pub use super::msg::{Effect, LiveEvent, Msg, RunJob, Screen};
 pub use super::workbench::{JointAngles, Loaded, SortKey, View};
 
 /// A question in front of every screen.
@@ -102,46 +105,30 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
             key(app, k)
         }
-        Msg::Mouse(m) => {
-            if app.screen == Screen::Trial && app.overlay.is_none() {
-                match m.kind {
-                    MouseEventKind::ScrollUp => trial::zoom(&mut app.wb, true),
-                    MouseEventKind::ScrollDown => trial::zoom(&mut app.wb, false),
-                    _ => {}
-                }
-            } else {
-                match m.kind {
-                    MouseEventKind::ScrollUp => return action(app, Action::Up),
-                    MouseEventKind::ScrollDown => return action(app, Action::Down),
-                    MouseEventKind::Down(MouseButton::Left)
-                        if app.screen == Screen::Trials && app.overlay.is_none() =>
-                    {
-                        // A click selects the row; on the selected row, opens it.
-                        let body = body_of(app.frame.get());
-                        if let Some(i) = trials::row_at(&app.wb, body, m.row) {
-                            if i == app.selected {
-                                return action(app, Action::Enter);
-                            }
-                            app.selected = i;
-                        }
-                    }
-                    _ => {}
-                }
-            }
-            vec![]
-        }
+        Msg::Mouse(m) => mouse(app, m),
         Msg::Resize => vec![],
         Msg::FileChanged(file, path) => {
+            if app.entry(&file).is_some_and(|e| e.following.is_some()) {
+                // Its follow reads the change (and notices a rewrite).
+                return vec![];
+            }
             match app.entry_mut(&file) {
                 Some(e) => {
-                    let chosen = e.chosen;
+                    let (chosen, gen) = (e.chosen, e.gen);
                     *e = TrialEntry::new(file.clone(), path.clone());
                     e.chosen = chosen.filter(|_| false);
+                    // A job of the replaced entry still running answers no more.
+                    e.gen = gen + 1;
                 }
                 None => {
                     app.trials.push(TrialEntry::new(file.clone(), path.clone()));
                     app.sort_trials();
                 }
+            }
+            if crate::file_names::is_plain_csv_name(&path) {
+                // A CSV trial that changes may be growing: followed as it
+                // grows, read whole once it stops.
+                return app.follow_effect(&file).into_iter().collect();
             }
             vec![Effect::Load {
                 files: vec![(file, path)],
@@ -150,6 +137,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                 model: app.model.clone(),
             }]
         }
+        Msg::Live { file, gen, event } => live(app, file, gen, event),
         Msg::FileRemoved(file) => {
             let keep = app.selected_entry().map(|e| e.file.clone());
             app.trials.retain(|t| t.file != file);
@@ -167,16 +155,28 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             vec![]
         }
         Msg::Loaded(file, result) => {
+            let mut effects = vec![];
             if let Some(e) = app.entry_mut(&file) {
+                if e.following.is_some() {
+                    // Read before it was seen growing: its follow has it.
+                    return vec![];
+                }
+                // Read whole: its live correction gives way to the final one.
+                e.live = None;
+                let correct = std::mem::take(&mut e.correct_when_loaded) && result.is_ok();
                 e.load = match result {
                     Ok(l) => LoadState::Loaded(l),
                     Err(m) => LoadState::Failed(m),
                 };
+                if correct {
+                    // It stopped growing: the final, offline correction.
+                    effects.extend(app.run_effect(&file, None));
+                }
             }
             if app.sort != SortKey::Name {
                 app.sort_trials();
             }
-            vec![]
+            effects
         }
         Msg::Progress { file, gen, pct } => {
             if let Some(e) = app.entry_mut(&file) {
@@ -309,6 +309,120 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             vec![]
         }
         Msg::PoseCalibrated(file, result) => super::pose::calibrated(&mut app.wb, &file, result),
+    }
+}
+
+/// A mouse event: the wheel scrolls (zooms the trial screen's time axis), a
+/// left click selects the row or column under it; a click on what is
+/// already selected does what Enter does there.
+fn mouse(app: &mut App, m: MouseEvent) -> Vec<Effect> {
+    if app.overlay.is_some() {
+        return match m.kind {
+            MouseEventKind::ScrollUp => action(app, Action::Up),
+            MouseEventKind::ScrollDown => action(app, Action::Down),
+            _ => vec![],
+        };
+    }
+    let body = body_of(app.frame.get());
+    match m.kind {
+        MouseEventKind::ScrollUp if app.screen == Screen::Trial => trial::zoom(&mut app.wb, true),
+        MouseEventKind::ScrollDown if app.screen == Screen::Trial => {
+            trial::zoom(&mut app.wb, false)
+        }
+        MouseEventKind::ScrollUp => return action(app, Action::Up),
+        MouseEventKind::ScrollDown => return action(app, Action::Down),
+        MouseEventKind::Down(MouseButton::Left) => match app.screen {
+            Screen::Trials => {
+                if let Some(i) = trials::row_at(&app.wb, body, m.row) {
+                    if i == app.selected {
+                        return action(app, Action::Enter);
+                    }
+                    app.selected = i;
+                }
+            }
+            Screen::Trial => {
+                if let Some(j) = trial::joint_at(&app.wb, body, m.column, m.row) {
+                    app.joint = j;
+                }
+            }
+            Screen::Compare => {
+                match compare::hit(app.compare_col, &app.wb, body, m.column, m.row) {
+                    Some(compare::Hit::Column(k)) => {
+                        if k == app.compare_col {
+                            return action(app, Action::Choose);
+                        }
+                        app.compare_col = k;
+                    }
+                    Some(compare::Hit::Joint(j)) => app.joint = j,
+                    None => {}
+                }
+            }
+            Screen::Limits if app.limits.edit.is_none() => {
+                if let Some((r, c)) = limits::cell_at(&app.wb, body, m.column, m.row) {
+                    let l = &mut app.limits;
+                    let c = c.clamp(FIRST_EDIT_COL, LAST_COL);
+                    if (r, c) == (l.row, l.col) {
+                        return action(app, Action::Enter);
+                    }
+                    (l.row, l.col) = (r, c);
+                }
+            }
+            _ => {}
+        },
+        _ => {}
+    }
+    vec![]
+}
+
+/// News of a trial followed as it grows.
+fn live(app: &mut App, file: String, gen: u64, event: LiveEvent) -> Vec<Effect> {
+    let open = app.open.as_deref() == Some(file.as_str());
+    let Some(e) = app.entry_mut(&file) else {
+        return vec![];
+    };
+    if e.following != Some(gen) {
+        return vec![];
+    }
+    match event {
+        LiveEvent::Snapshot(s) => {
+            let before = e.loaded().map_or(0.0, |l| l.trial.duration_s());
+            let after = s.loaded.trial.duration_s();
+            e.load = LoadState::Loaded(s.loaded);
+            e.live = Some(s.trace);
+            if open {
+                trial::grown(&mut app.wb, before, after);
+            }
+            vec![]
+        }
+        LiveEvent::Restarted(why) => {
+            e.live = None;
+            e.results.clear();
+            e.report = None;
+            app.error(why);
+            vec![]
+        }
+        LiveEvent::Ended { result, grew } => {
+            e.following = None;
+            let path = e.path.clone();
+            match result {
+                Ok(()) => {
+                    e.correct_when_loaded = grew;
+                    if grew {
+                        app.info(format!(
+                            "{file} stopped growing: reading it whole for the final correction"
+                        ));
+                    }
+                }
+                // Read whole, the file tells what is wrong with it.
+                Err(why) => app.error(format!("{file}: cannot follow: {why}")),
+            }
+            vec![Effect::Load {
+                files: vec![(file, path)],
+                limits: app.limits.table.clone(),
+                glitch_deg: app.limits.settings.glitch_deg,
+                model: app.model.clone(),
+            }]
+        }
     }
 }
 
@@ -533,6 +647,7 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         _ => {}
     }
     app.message = None;
+    let variant = app.variant;
     let reply = match app.screen {
         Screen::Trials => trials::action(&mut app.wb, a),
         Screen::Trial => trial::action(&mut app.wb, a),
@@ -542,7 +657,20 @@ fn action(app: &mut App, a: Action) -> Vec<Effect> {
         Screen::Calibration => calibration::action(&mut app.calib, &mut app.wb, a),
         Screen::Histogram => histogram::action(&mut app.histogram, &mut app.wb, a),
     };
-    follow(app, reply)
+    let mut effects = follow(app, reply);
+    if app.variant != variant {
+        // Trials followed as they grow are followed again with the variant shown.
+        let following: Vec<String> = app
+            .trials
+            .iter()
+            .filter(|e| e.following.is_some())
+            .map(|e| e.file.clone())
+            .collect();
+        for f in following {
+            effects.extend(app.follow_effect(&f));
+        }
+    }
+    effects
 }
 
 /// The screens' area of a frame: all but the title and status rows.

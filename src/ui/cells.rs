@@ -40,6 +40,26 @@ pub fn fit(s: &str, w: usize) -> String {
     }
 }
 
+/// Fits a name to `w` characters keeping both its ends (`~` marks the
+/// characters left out of its middle), so that names sharing a long start,
+/// or a long end, still read apart: `2024-03-12_subject07_trial03.csv` in
+/// 16 is `2024-03-~l03.csv`. Padded when short.
+pub fn abbreviate(s: &str, w: usize) -> String {
+    let n = s.chars().count();
+    if n <= w {
+        return format!("{s:<w$}");
+    }
+    if w < 5 {
+        return fit(s, w);
+    }
+    let tail = (w - 1) / 2;
+    let head = w - 1 - tail;
+    let mut t: String = s.chars().take(head).collect();
+    t.push('~');
+    t.extend(s.chars().skip(n - tail));
+    t
+}
+
 /// A style for selected rows.
 pub fn sel(theme: &Theme, selected: bool) -> Style {
     if selected {
@@ -91,5 +111,20 @@ mod tests {
         assert_eq!(list_move(Action::Down, 0, 0, 10), None);
         assert_eq!(counter(72, 100), "73/100");
         assert_eq!(counter(0, 0), "0/0");
+    }
+
+    #[test]
+    fn long_names_keep_both_ends() {
+        let a = abbreviate("2024-03-12_subject07_trial03.csv", 16);
+        let b = abbreviate("2024-03-12_subject07_trial04.csv", 16);
+        assert_eq!(a, "2024-03-~l03.csv");
+        assert_ne!(a, b);
+        assert_eq!(abbreviate("knee.csv", 10), "knee.csv  ");
+        assert_eq!(abbreviate("knee_calf.csv", 4), "kne~");
+        for s in ["", "x", "long name here"] {
+            for w in 0..20 {
+                assert_eq!(abbreviate(s, w).chars().count(), w, "{s:?} in {w}");
+            }
+        }
     }
 }

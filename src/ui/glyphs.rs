@@ -12,6 +12,9 @@ pub struct Glyphs {
     pub raw: Marker,
     /// The corrected angle of the variant shown.
     pub corrected: Marker,
+    /// The corrected angle of a growing trial past its newest solve
+    /// (extrapolated from it).
+    pub extrapolated: Marker,
     /// A reference (ground-truth or motion-capture) angle.
     pub reference: Marker,
     /// Lower and upper limit lines.
@@ -24,6 +27,10 @@ pub struct Glyphs {
     pub glitch: Marker,
     /// Scatter classes: within the limits, up to 10 deg out, beyond.
     pub classes: [Marker; 3],
+    /// The views' outlines (the globe's rim and grid, the limit band): the
+    /// fine marker, but its own character in ASCII, where the points inside
+    /// have the fine marker's.
+    pub outline: Marker,
 }
 
 /// Time bands of the views when there is no colour: earliest `1` to latest `6`.
@@ -39,6 +46,7 @@ impl Glyphs {
             return Glyphs {
                 raw: Marker::Custom('.'),
                 corrected: Marker::Custom('*'),
+                extrapolated: Marker::Custom('~'),
                 reference: Marker::Custom('o'),
                 limit: Marker::Custom('='),
                 centroid: Marker::Custom('-'),
@@ -49,6 +57,7 @@ impl Glyphs {
                     Marker::Custom('+'),
                     Marker::Custom('x'),
                 ],
+                outline: Marker::Custom(':'),
             };
         }
         let fine = if braille {
@@ -59,12 +68,14 @@ impl Glyphs {
         Glyphs {
             raw: fine,
             corrected: Marker::HalfBlock,
+            extrapolated: Marker::Custom('░'),
             reference: Marker::Custom('∘'),
             limit: Marker::Custom('═'),
             centroid: Marker::Custom('┄'),
             cursor: Marker::Custom('┊'),
             glitch: Marker::Custom('×'),
             classes: [fine, Marker::Custom('+'), Marker::Custom('×')],
+            outline: fine,
         }
     }
 
@@ -111,6 +122,7 @@ mod tests {
             let all = [
                 g.raw,
                 g.corrected,
+                g.extrapolated,
                 g.reference,
                 g.limit,
                 g.centroid,
@@ -129,6 +141,8 @@ mod tests {
             );
             if ascii {
                 assert!(samples.iter().chain(&classes).all(|s| s.is_ascii()));
+                // The views' outlines read apart from the points inside them.
+                assert!(!classes.contains(&sample(g.outline)));
             }
         }
     }

@@ -71,3 +71,27 @@ pub struct SavedOutput {
     pub settings: crate::limits::Settings,
     pub limits_hash: String,
 }
+
+/// The correction of a trial being followed while another program appends
+/// to it: as many samples as the trial read so far, corrected by the newest
+/// solve of the growing trial before `solved`, by the correction extrapolated
+/// from that solve after it (see [`crate::follow`]).
+#[derive(Debug, Clone)]
+pub struct LiveTrace {
+    /// The variant the rows are corrected with.
+    pub variant: crate::acm::Variant,
+    /// The corrected samples (same times as the trial read so far).
+    pub corrected: Arc<Trial>,
+    /// Joint angles of `corrected`, filled on demand.
+    pub angles: AngleCache,
+    /// Samples the newest solve covers (0: nothing solved yet, all extrapolated).
+    pub solved: usize,
+    /// Trial time the newest solve reaches, seconds from the first sample.
+    pub solved_s: f64,
+    /// A solve is under way.
+    pub solving: bool,
+    /// The file grew since following began.
+    pub grew: bool,
+    /// What went wrong last (a solve that failed, a restart), if anything.
+    pub note: Option<String>,
+}

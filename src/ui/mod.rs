@@ -6,12 +6,14 @@
 //! * [`msg`]: messages, effects and navigation (a leaf);
 //! * [`screens`]: one module per screen, each with its state, keys and drawing;
 //! * [`app`]: the router, `update(&mut App, Msg) -> Vec<Effect>` (no I/O);
+//! * [`axis`]: round y-axis ticks the charts share;
 //! * [`render`]: the frame around the screens (title, status bar, overlays);
 //! * [`jobs`]: the work behind effects, and a synchronous runner for tests;
 //! * [`runtime`]: terminal, event loop, workers, file watching;
 //! * [`headless`]: any screen as text (`acmw render`, snapshot tests).
 
 pub mod app;
+pub mod axis;
 pub mod cells;
 pub mod glitches;
 pub mod glyphs;

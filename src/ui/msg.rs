@@ -2,7 +2,7 @@
 //! results, file events), effects out (jobs for the runtime), and the
 //! navigation a screen asks the router for. A leaf: it names no screen.
 
-use super::loaded::Loaded;
+use super::loaded::{LiveTrace, Loaded};
 use crate::acm::{Correction, Variant};
 use crate::analysis::centroid::CentroidTable;
 use crate::analysis::histogram::JointHistogram;
@@ -79,6 +79,10 @@ pub enum Effect {
     Debounce,
     /// Turn mouse capture on or off (`M`).
     Mouse(bool),
+    /// Follow a trial another program is appending to (answered by
+    /// `Msg::Live` until it stops growing; a newer follow of the same trial
+    /// replaces an older one).
+    Follow(Box<FollowJob>),
     /// Pose-calibrate a loaded trial (answered by `Msg::PoseCalibrated`).
     PoseCalibrate {
         file: String,
@@ -102,6 +106,46 @@ pub struct RunJob {
     /// With `recorrect`: override `auto`'s choice for this joint with this
     /// variant (None: back to auto's own); the other variants are kept.
     pub auto_override: Option<(String, Option<Variant>)>,
+}
+
+/// A trial to follow while it grows, and how to correct it.
+#[derive(Debug, Clone)]
+pub struct FollowJob {
+    pub file: String,
+    pub path: PathBuf,
+    /// Generation of the follow; messages of older ones are ignored.
+    pub gen: u64,
+    /// The model to read it with (None: detected from its header).
+    pub model: Option<Arc<Model>>,
+    pub limits: LimitTable,
+    pub limits_source: String,
+    pub settings: Settings,
+    pub variant: Variant,
+}
+
+/// What following a growing trial reports.
+#[derive(Debug, Clone)]
+pub enum LiveEvent {
+    /// The rows read so far and their correction.
+    Snapshot(Box<LiveSnapshot>),
+    /// The file was truncated, replaced or rewritten: read again from its
+    /// start (why, for the status line).
+    Restarted(String),
+    /// Following ended: the file stopped growing (`Ok`), or cannot be
+    /// followed (why, located). `grew`: it grew while followed.
+    Ended {
+        result: Result<(), String>,
+        grew: bool,
+    },
+}
+
+/// A growing trial as read so far.
+#[derive(Debug, Clone)]
+pub struct LiveSnapshot {
+    /// The rows read so far (no truth, reference or glitches yet: those are
+    /// read with the whole file once it stops growing).
+    pub loaded: Arc<Loaded>,
+    pub trace: LiveTrace,
 }
 
 /// Everything that happens to the workbench.
@@ -144,6 +188,12 @@ pub enum Msg {
     Histograms(Box<Computed>),
     /// A suggested limit table or a centroid table was written (its path), or why not.
     TableWritten(Result<String, String>),
+    /// News of a trial being followed as it grows.
+    Live {
+        file: String,
+        gen: u64,
+        event: LiveEvent,
+    },
     /// A pose-calibrated version of a trial, or why there is none.
     PoseCalibrated(String, Result<Arc<Loaded>, String>),
 }

@@ -28,6 +28,12 @@ use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+/// How often a trial being followed is looked at.
+pub const LIVE_POLL: Duration = Duration::from_millis(100);
+/// A trial being followed that has not grown for this long is complete: it
+/// is read whole and corrected (a writer that resumes later is followed anew).
+pub const LIVE_IDLE: Duration = Duration::from_secs(5);
+
 /// Delay between a limit edit and the re-correction it causes.
 pub const RECORRECT_DEBOUNCE: Duration = Duration::from_millis(300);
 
@@ -267,6 +273,8 @@ struct Workers {
     dir: PathBuf,
     /// One job slot per trial: the cancel flag of its newest job.
     jobs: HashMap<String, Arc<AtomicBool>>,
+    /// One follow per trial: the cancel flag of its newest.
+    follows: HashMap<String, Arc<AtomicBool>>,
     debounce: Option<Instant>,
 }
 
@@ -321,6 +329,31 @@ impl Workers {
                     let _ = tx.send(Event::Msg(msg));
                 });
             }
+            Effect::Follow(job) => {
+                let cancel = Arc::new(AtomicBool::new(false));
+                if let Some(old) = self.follows.insert(job.file.clone(), cancel.clone()) {
+                    old.store(true, Ordering::Relaxed);
+                }
+                std::thread::spawn(move || {
+                    let file = job.file.clone();
+                    let gen = job.gen;
+                    let send = |m: Msg| tx.send(Event::Msg(m)).is_ok();
+                    let caught = super::signals::caught(|| {
+                        jobs::live::run(*job, &cancel, LIVE_POLL, LIVE_IDLE, send);
+                        Ok(())
+                    });
+                    if let Err(e) = caught {
+                        let _ = tx.send(Event::Msg(Msg::Live {
+                            file,
+                            gen,
+                            event: super::msg::LiveEvent::Ended {
+                                result: Err(e),
+                                grew: false,
+                            },
+                        }));
+                    }
+                });
+            }
             Effect::Debounce => self.debounce = Some(Instant::now() + RECORRECT_DEBOUNCE),
             Effect::Mouse(on) => {
                 let _ = set_mouse(on);
@@ -371,6 +404,7 @@ fn event_loop(app: &mut App, opts: &Options) -> anyhow::Result<Option<i32>> {
         tx: tx.clone(),
         dir: opts.dir.clone(),
         jobs: HashMap::new(),
+        follows: HashMap::new(),
         debounce: None,
     };
     for e in app.start() {

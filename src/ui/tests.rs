@@ -4,6 +4,7 @@
 
 mod flows;
 mod layers;
+mod live;
 mod views;
 
 use super::app::{update, App, Msg, Overlay};
@@ -482,7 +483,7 @@ fn trial_charts_read_without_colour() {
 
 #[test]
 fn ticks_are_round_and_few() {
-    use super::screens::trial::ticks;
+    use super::axis::ticks;
     assert_eq!(ticks(-7.2, 136.4, 5), (50.0, vec![0.0, 50.0, 100.0]));
     assert_eq!(
         ticks(-7.2, 136.4, 8).1,
@@ -656,6 +657,43 @@ fn mouse_clicks_select_and_m_toggles_capture() {
     SyncRunner::send(&mut app, click(3));
     assert_eq!(app.screen, Screen::Trial);
     assert_eq!(app.open.as_deref(), Some("fb.csv.gz"));
+    let at = |column, row| {
+        Msg::Mouse(MouseEvent {
+            kind: MouseEventKind::Down(MouseButton::Left),
+            column,
+            row,
+            modifiers: KeyModifiers::NONE,
+        })
+    };
+    // The trial screen's joint list: title row, header, then the joints.
+    let _ = draw(&app, &Theme::default(), 80, 24);
+    SyncRunner::send(&mut app, at(5, 4));
+    assert_eq!(app.joint, 2);
+    // The compare screen at 80 columns: joint names (12) and the raw column
+    // (14) after a 2-column margin, then 15-column variant columns.
+    keys(&mut app, "rc");
+    assert_eq!(app.screen, Screen::Compare);
+    let _ = draw(&app, &Theme::default(), 80, 24);
+    SyncRunner::send(&mut app, at(28 + 2 * 15 + 3, 2));
+    assert_eq!(app.compare_col, 2, "a click on a column header picks it");
+    SyncRunner::send(&mut app, at(28 + 2 * 15 + 3, 2));
+    let chosen = app.open_entry().unwrap().chosen;
+    assert_eq!(chosen, Some(Variant::ALL[2]), "a second click chooses it");
+    SyncRunner::send(&mut app, at(5, 1 + 2 + 5));
+    assert_eq!(app.joint, 5, "a click on a joint row selects it");
+    SyncRunner::send(&mut app, at(28 + 15 + 3, 1 + 2 + 5));
+    assert_eq!(app.compare_col, 1, "a click on a cell picks its column");
+    // The limits editor: a click selects a cell, a second one edits it.
+    keys(&mut app, "L");
+    assert_eq!(app.screen, Screen::Limits);
+    let _ = draw(&app, &Theme::default(), 80, 24);
+    let before = app.limits.row;
+    SyncRunner::send(&mut app, at(40, 2 + 3));
+    assert_ne!(app.limits.row, before);
+    let (row, col) = (app.limits.row, app.limits.col);
+    SyncRunner::send(&mut app, at(40, 2 + 3));
+    assert!(app.limits.edit.is_some(), "row {row} col {col}");
+    key(&mut app, KeyCode::Esc);
     assert!(!app.mouse);
     let fx_m = update(&mut app, Msg::Key(KeyEvent::from(KeyCode::Char('M'))));
     assert!(app.mouse);

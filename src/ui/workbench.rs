@@ -3,8 +3,8 @@
 //! (open trial, joint, time cursor, variant) and the status message. Screens
 //! read and change it; none of them owns it. No I/O here.
 
-pub use super::loaded::{AngleCache, JointAngles, Loaded, SavedOutput};
-use super::msg::{Effect, RunJob};
+pub use super::loaded::{AngleCache, JointAngles, LiveTrace, Loaded, SavedOutput};
+use super::msg::{Effect, FollowJob, RunJob};
 use crate::acm::{Correction, Variant};
 use crate::limits::{LimitTable, Settings, SettingsFile};
 use crate::metrics::JointFigures;
@@ -51,6 +51,13 @@ pub struct TrialEntry {
     pub chosen: Option<Variant>,
     /// The variant whose save is under way.
     pub saving: Option<Variant>,
+    /// The generation of the newest follow of this trial while another
+    /// program appends to it (None: not followed).
+    pub following: Option<u64>,
+    /// The correction of the rows read while followed.
+    pub live: Option<LiveTrace>,
+    /// Correct every variant once the trial is read whole (it stopped growing).
+    pub correct_when_loaded: bool,
 }
 
 impl TrialEntry {
@@ -65,6 +72,9 @@ impl TrialEntry {
             report: None,
             chosen: None,
             saving: None,
+            following: None,
+            live: None,
+            correct_when_loaded: false,
         }
     }
 
@@ -111,6 +121,7 @@ impl TrialEntry {
         let on_disk = self.loaded().is_some_and(|l| l.on_disk.contains_key(&v));
         match self.results.get(&v) {
             _ if self.saving == Some(v) => "saving".into(),
+            _ if self.live.as_ref().is_some_and(|l| l.variant == v) => "live".into(),
             Some(r) if r.saved.is_some() => "saved".into(),
             None if on_disk && self.running.is_none() => "saved".into(),
             Some(_) if self.chosen == Some(v) => "chosen".into(),
@@ -668,6 +679,12 @@ impl Workbench {
         let limits_source = self.limits.source.clone();
         let settings = self.settings;
         let e = self.entry_mut(file)?;
+        if e.following.is_some() {
+            self.info(format!(
+                "{file} is growing: corrected as it grows; every variant runs once it stops"
+            ));
+            return None;
+        }
         let loaded = e.loaded()?.clone();
         let recorrect = match recorrect {
             Some(joints) if e.results.len() == Variant::ALL.len() => Some((
@@ -707,6 +724,28 @@ impl Workbench {
             job.auto_override = Some((joint.to_string(), choice));
         }
         Some(effect)
+    }
+
+    /// The job following `file` as it grows, corrected with the variant
+    /// shown (replacing any earlier follow of it).
+    pub fn follow_effect(&mut self, file: &str) -> Option<Effect> {
+        let limits = self.limits.table.clone();
+        let limits_source = self.limits.source.clone();
+        let (settings, variant, model) = (self.settings, self.variant, self.model.clone());
+        let e = self.entry_mut(file)?;
+        e.gen += 1;
+        e.following = Some(e.gen);
+        e.running = None;
+        Some(Effect::Follow(Box::new(FollowJob {
+            file: file.to_string(),
+            path: e.path.clone(),
+            gen: e.gen,
+            model,
+            limits,
+            limits_source,
+            settings,
+            variant,
+        })))
     }
 
     /// Shows the next variant.

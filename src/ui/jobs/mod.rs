@@ -4,6 +4,7 @@
 
 pub mod calibration;
 pub mod histogram;
+pub mod live;
 pub mod pose;
 
 use super::app::{update, App};
@@ -359,6 +360,7 @@ pub fn execute(app_dir: &Path, effect: Effect) -> Vec<Msg> {
             calibration,
             limits,
         } => vec![pose::calibrate_job(&file, &loaded, &calibration, &limits)],
+        Effect::Follow(job) => live::follow_once(*job),
     }
 }
 

@@ -25,15 +25,117 @@ fn column_label(v: Variant) -> &'static str {
     v.info().column
 }
 
+/// Width of the joint-name column.
+const NAME_W: usize = 12;
+/// Width of one entry of the status list when it runs in several columns.
+const STATUS_W: usize = 30;
+
+/// Where the compare screen puts things in an area: the variant columns in
+/// view and their place, the joint rows in view, the status list's columns.
+struct Geometry {
+    /// Width of the raw column and of each variant column.
+    cw: usize,
+    col_w: usize,
+    /// Columns before the first variant column.
+    fixed: usize,
+    cols: std::ops::Range<usize>,
+    /// First joint row shown and how many are.
+    first_joint: usize,
+    joint_rows: usize,
+    /// Columns of the status list (several when the rows are few).
+    status_cols: usize,
+}
+
+fn geometry(col: usize, app: &Workbench, area: Rect) -> Option<Geometry> {
+    let e = app.open_entry()?;
+    let truth = e.loaded().is_some_and(|l| l.truth.is_some());
+    let cw = if truth { 14 } else { 8 };
+    let col_w = cw.max(15);
+    let fixed = 2 + NAME_W + cw;
+    let cols = visible_columns(area.width as usize, fixed, col_w, col);
+    let joints = e.figures(None).map_or(0, <[JointFigures]>::len);
+    // Title, header, mean, a blank line, and the notes below the status list.
+    let notes = usize::from(e.results.is_empty() && e.running.is_none())
+        + usize::from(e.loaded().is_some_and(|l| l.truth_error.is_some()));
+    let fixed_rows = 4 + notes;
+    let h = area.height as usize;
+    let n = Variant::ALL.len();
+    // The status list runs in as many columns as it needs to leave the
+    // joints room (up to what the width holds), then the joints scroll.
+    let most = (area.width as usize / STATUS_W).max(1);
+    // In columns the saved outputs' paths get a line each below the list.
+    let saved = saved_lines(e).len();
+    let status_rows = |cols: usize| n.div_ceil(cols) + if cols > 1 { saved } else { 0 };
+    let mut status_cols = 1;
+    while status_cols < most && fixed_rows + joints + status_rows(status_cols) > h {
+        status_cols += 1;
+    }
+    let joint_rows = h
+        .saturating_sub(fixed_rows + status_rows(status_cols))
+        .clamp(1, joints.max(1));
+    let first_joint = app.joint.saturating_sub(joint_rows - 1);
+    Some(Geometry {
+        cw,
+        col_w,
+        fixed,
+        cols,
+        first_joint,
+        joint_rows,
+        status_cols,
+    })
+}
+
+/// `variant -> path` of each saved variant of `e`.
+fn saved_lines(e: &crate::ui::workbench::TrialEntry) -> Vec<String> {
+    Variant::ALL
+        .iter()
+        .filter_map(|v| {
+            let p = e.results.get(v)?.saved.as_ref()?;
+            Some(format!("  {v} -> {p}"))
+        })
+        .collect()
+}
+
+/// What a click at (`x`, `y`) of the screen lands on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hit {
+    /// A variant column (index into `Variant::ALL`).
+    Column(usize),
+    /// A joint row (index into the trial's joints).
+    Joint(usize),
+}
+
+/// The column or joint row drawn at (`x`, `y`), `area` being the screen's area.
+pub fn hit(col: usize, app: &Workbench, area: Rect, x: u16, y: u16) -> Option<Hit> {
+    let g = geometry(col, app, area)?;
+    let row = y.checked_sub(area.y)? as usize;
+    let x = x.checked_sub(area.x)? as usize;
+    // Row 1 is the header, the joints follow.
+    let on_joint = (2..2 + g.joint_rows).contains(&row);
+    if (row == 1 || on_joint) && x >= g.fixed {
+        let k = g.cols.start + (x - g.fixed) / g.col_w;
+        if k < g.cols.end {
+            return Some(Hit::Column(k));
+        }
+    }
+    if on_joint {
+        let j = g.first_joint + row - 2;
+        if j < app.open_joints().len() {
+            return Some(Hit::Joint(j));
+        }
+    }
+    None
+}
+
 pub fn render(col: usize, app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
-    let Some(e) = app.open_entry() else {
+    let (Some(e), Some(g)) = (app.open_entry(), geometry(col, app, area)) else {
         f.render_widget(Paragraph::new("no trial open"), area);
         return;
     };
     let truth = e.loaded().is_some_and(|l| l.truth.is_some());
-    let cw = if truth { 14 } else { 8 };
-    let nw = 12usize;
-    let cols = visible_columns(area.width as usize, 2 + nw + cw, cw.max(15), col);
+    let cw = g.cw;
+    let nw = NAME_W;
+    let cols = g.cols.clone();
     let mut title = if truth {
         "joint mean excursion, deg  /  truth RMS error, deg (mean of X Y Z)".to_string()
     } else {
@@ -103,7 +205,12 @@ pub fn render(col: usize, app: &Workbench, theme: &Theme, f: &mut Frame, area: R
         let v = *v;
         mean.push(num(e.mean_excursion(Some(v)), 6));
     }
-    for (k, (name, cells)) in rows.iter().enumerate() {
+    for (k, (name, cells)) in rows
+        .iter()
+        .enumerate()
+        .skip(g.first_joint)
+        .take(g.joint_rows)
+    {
         let mut spans = vec![Span::raw(format!("{name}{:>w$}", cells[0], w = cw))];
         for (c, text) in cells[1..].iter().enumerate() {
             let style = if cols.start + c == col {
@@ -136,18 +243,40 @@ pub fn render(col: usize, app: &Workbench, theme: &Theme, f: &mut Frame, area: R
     lines.push(Line::from(spans));
     lines.extend(auto_lines(app, e, theme, area.width as usize));
     lines.push(Line::from(""));
-    let mut status = vec![];
-    for v in Variant::ALL {
-        let s = e.variant_status(v);
-        let saved = e
-            .results
-            .get(&v)
-            .and_then(|r| r.saved.clone())
-            .map(|p| format!(" -> {p}"))
-            .unwrap_or_default();
-        status.push(Line::from(format!("  {:<24}{s}{saved}", v.name())));
+    if g.status_cols == 1 {
+        for v in Variant::ALL {
+            let s = e.variant_status(v);
+            let saved = e
+                .results
+                .get(&v)
+                .and_then(|r| r.saved.clone())
+                .map(|p| format!(" -> {p}"))
+                .unwrap_or_default();
+            lines.push(Line::from(format!("  {:<24}{s}{saved}", v.name())));
+        }
+    } else {
+        // Short of rows: the list runs down then across, each name cut to
+        // leave its status whole.
+        let per = Variant::ALL.len().div_ceil(g.status_cols);
+        let w = (area.width as usize / g.status_cols).max(STATUS_W);
+        for r in 0..per {
+            let mut text = String::new();
+            for c in 0..g.status_cols {
+                let Some(v) = Variant::ALL.get(c * per + r) else {
+                    continue;
+                };
+                let s = e.variant_status(*v);
+                let name_w = w.saturating_sub(3 + s.chars().count().max(6));
+                text.push_str(&format!("  {} {s:<6}", fit(v.name(), name_w)));
+                let pad = (c + 1) * w;
+                while text.chars().count() < pad {
+                    text.push(' ');
+                }
+            }
+            lines.push(Line::from(text.trim_end().to_string()));
+        }
+        lines.extend(saved_lines(e).into_iter().map(Line::from));
     }
-    lines.extend(status);
     if e.results.is_empty() && e.running.is_none() {
         lines.push(Line::from(Span::styled(
             "  not run yet: r runs all variants",
@@ -255,8 +384,12 @@ pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
         Action::Back => return Reply::nav(Nav::To(Screen::Trial)),
         Action::Left => *col = col.saturating_sub(1),
         Action::Right => *col = (*col + 1).min(Variant::ALL.len() - 1),
-        Action::Up => app.joint = app.joint.saturating_sub(1),
-        Action::Down => app.joint = (app.joint + 1).min(app.open_joints().len().saturating_sub(1)),
+        a if a.moves_in_list() => {
+            let n = app.open_joints().len();
+            if let Some(j) = crate::ui::cells::list_move(a, app.joint, n, 10) {
+                app.joint = j;
+            }
+        }
         Action::Run => return app.run_effect(&file, None).into(),
         // `o` here: the next of auto's candidates for the selected joint.
         Action::Globe => return override_next(app, &file),

@@ -27,14 +27,45 @@ fn widths(total: usize) -> [usize; 7] {
     ]
 }
 
-pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
-    let l = &app.limits;
-    let [head, table, foot] = Layout::vertical([
-        Constraint::Length(1 + u16::from(l.disk_error.is_some())),
+/// The heading, the table and the footer of the screen in `area`.
+fn areas(app: &Workbench, area: Rect) -> [Rect; 3] {
+    Layout::vertical([
+        Constraint::Length(1 + u16::from(app.limits.disk_error.is_some())),
         Constraint::Min(1),
         Constraint::Length(3),
     ])
-    .areas(area);
+    .areas(area)
+}
+
+/// The (row, column) of the cell drawn at (`x`, `y`), `area` being the
+/// screen's area (a settings row has its value in column 3).
+pub fn cell_at(app: &Workbench, area: Rect, x: u16, y: u16) -> Option<(usize, usize)> {
+    let l = &app.limits;
+    let [_, table, _] = areas(app, area);
+    let rows = table.height.saturating_sub(1) as usize;
+    let k = y.checked_sub(table.y + 1)? as usize;
+    let first = l.row.saturating_sub(rows.saturating_sub(1));
+    let r = first + k;
+    if k >= rows || r >= l.rows() {
+        return None;
+    }
+    if r >= l.table.rows.len() {
+        return Some((r, 3));
+    }
+    let w = widths(table.width as usize);
+    let mut at = (x.checked_sub(table.x)? as usize).checked_sub(2)?;
+    for (c, cw) in w.iter().enumerate() {
+        if at < *cw {
+            return Some((r, c));
+        }
+        at -= cw;
+    }
+    Some((r, l.col))
+}
+
+pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
+    let l = &app.limits;
+    let [head, table, foot] = areas(app, area);
     let dirty = if l.dirty() {
         "  * unsaved changes (w saves)"
     } else {

@@ -16,6 +16,7 @@ use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragrap
 use ratatui::Frame;
 
 pub use crate::plot::envelope::envelope;
+use crate::ui::axis;
 
 /// The sample index nearest to `ts` (times `t` already relative).
 fn index_at(t: &[f64], ts: f64) -> usize {
@@ -44,15 +45,8 @@ fn figures_of<'a>(figs: Option<&'a [JointFigures]>, joint: &str) -> Option<&'a J
     figs?.iter().find(|f| f.joint == joint)
 }
 
-pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
-    let Some(e) = app.open_entry() else {
-        f.render_widget(Paragraph::new("no trial open (Esc)"), area);
-        return;
-    };
-    let Some(l) = e.loaded() else {
-        f.render_widget(Paragraph::new("trial not loaded"), area);
-        return;
-    };
+/// The joint list, the figures below it and the charts beside them.
+fn panes(area: Rect) -> [Rect; 3] {
     let left_w = match area.width {
         100.. => 32,
         80.. => 26,
@@ -63,6 +57,32 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         Layout::horizontal([Constraint::Length(left_w), Constraint::Min(1)]).areas(area);
     let figs_h = 9.min(left.height / 2);
     let [jl, fl] = Layout::vertical([Constraint::Min(1), Constraint::Length(figs_h)]).areas(left);
+    [jl, fl, right]
+}
+
+/// The joint (index into the open trial's joints) listed at (`x`, `y`),
+/// `area` being the screen's area.
+pub fn joint_at(app: &Workbench, area: Rect, x: u16, y: u16) -> Option<usize> {
+    let [jl, _, _] = panes(area);
+    if x < jl.x || x >= jl.right() {
+        return None;
+    }
+    let rows = jl.height.saturating_sub(1) as usize;
+    let k = y.checked_sub(jl.y + 1)? as usize;
+    let j = app.joint.saturating_sub(rows.saturating_sub(1)) + k;
+    (k < rows && j < app.open_joints().len()).then_some(j)
+}
+
+pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
+    let Some(e) = app.open_entry() else {
+        f.render_widget(Paragraph::new("no trial open (Esc)"), area);
+        return;
+    };
+    let Some(l) = e.loaded() else {
+        f.render_widget(Paragraph::new("trial not loaded"), area);
+        return;
+    };
+    let [jl, fl, right] = panes(area);
 
     // Joint list.
     let joints: Vec<&JointFigures> = l.before.iter().collect();
@@ -109,10 +129,20 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         return;
     };
     let raw = l.angles.get(&l.trial, joint).unwrap_or_default();
-    let cor = e
-        .results
-        .get(&app.variant)
-        .and_then(|r| r.angles.get(&r.correction.corrected, joint));
+    // A growing trial: its correction so far, solved then extrapolated.
+    let live = e
+        .live
+        .as_ref()
+        .filter(|v| v.corrected.len() == l.trial.len());
+    let cor = match live {
+        Some(v) => v.angles.get(&v.corrected, joint),
+        None => e
+            .results
+            .get(&app.variant)
+            .and_then(|r| r.angles.get(&r.correction.corrected, joint)),
+    };
+    let solved = live.map(|v| v.solved);
+    let shown = live.map_or(app.variant, |v| v.variant);
     let lim = app
         .limits
         .table
@@ -140,6 +170,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
             axis,
             raw: &raw,
             cor: cor.as_deref().map(Vec::as_slice),
+            solved,
             reference: reference.and_then(|r| r[axis].as_deref()),
             range: lim.map(|l| l.range_deg[axis]),
             centroid: lim.and_then(|l| l.centroid_deg).map(|c| c[axis]),
@@ -158,9 +189,9 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let label_w = frames
         .iter()
         .flatten()
-        .flat_map(|fr| fr.labels.iter().map(|(_, s)| s.chars().count()))
+        .map(|fr| axis::width(&fr.labels))
         .max()
-        .unwrap_or(1) as u16;
+        .unwrap_or(1);
     for (axis, (d, fr)) in data.iter().zip(frames).enumerate() {
         let Some(fr) = fr else { continue };
         let mut title = vec![Span::styled(
@@ -184,7 +215,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         ));
         if let Some(c) = &cor {
             title.push(Span::styled(
-                format!("{} {} ", app.variant, num(c.get(ci).map(|a| a[axis]), 0)),
+                format!("{shown} {} ", num(c.get(ci).map(|a| a[axis]), 0)),
                 theme.corrected,
             ));
         }
@@ -197,11 +228,19 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     }
     // (glyph, name, short name, style) of what the charts show.
     let mut legend = vec![(sample(glyphs.raw), "raw".to_string(), "", theme.raw)];
-    if cor.is_some() {
+    if cor.is_some() && solved != Some(0) {
+        let name = if live.is_some() {
+            format!("{shown} solved")
+        } else {
+            shown.to_string()
+        };
+        legend.push((sample(glyphs.corrected), name, "", theme.corrected));
+    }
+    if live.is_some_and(|v| v.solved < v.corrected.len()) {
         legend.push((
-            sample(glyphs.corrected),
-            app.variant.to_string(),
-            "",
+            sample(glyphs.extrapolated),
+            "extrapolated".into(),
+            "ext",
             theme.corrected,
         ));
     }
@@ -253,7 +292,20 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     let note = e
         .variant_note_short(app.variant)
         .filter(|_| e.running.is_none());
-    let status = if let Some(p) = e.running {
+    let status = if let Some(v) = live {
+        let n = l.trial.len();
+        let solving = if v.solving { ", solving" } else { "" };
+        if v.solved == 0 {
+            format!("LIVE {n} rows, not solved yet{solving}")
+        } else if foot.width >= 80 {
+            format!(
+                "LIVE {n} rows, solved 0-{:.1} s{solving}, extrapolated after",
+                v.solved_s
+            )
+        } else {
+            format!("LIVE {n} solved {:.0}s", v.solved_s)
+        }
+    } else if let Some(p) = e.running {
         format!("running {p}%")
     } else if note.is_some() {
         String::new()
@@ -265,7 +317,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
     // A running correction first: it must not be cut at narrow widths; the
     // span and cursor shorter there.
     let zoom = 1u32 << app.view.zoom.min(16);
-    let (running, done) = if e.running.is_some() {
+    let (running, done) = if e.running.is_some() || live.is_some() {
         (format!(" {status} "), String::new())
     } else {
         (String::new(), status)
@@ -296,6 +348,12 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
             ),
             Span::styled(note.unwrap_or_default(), theme.warn),
             Span::styled(
+                live.and_then(|v| v.note.clone())
+                    .map(|n| format!("  {n}"))
+                    .unwrap_or_default(),
+                theme.warn,
+            ),
+            Span::styled(
                 crate::ui::pose::label(l)
                     .map(|p| format!("  {p}"))
                     .unwrap_or_default(),
@@ -322,6 +380,9 @@ struct ChartData<'a> {
     axis: usize,
     raw: &'a [[f64; 3]],
     cor: Option<&'a [[f64; 3]]>,
+    /// A growing trial's first extrapolated sample of `cor` (None: all of
+    /// `cor` is solved).
+    solved: Option<usize>,
     /// The optical reference's angle of this axis per sample (NaN: none).
     reference: Option<&'a [f64]>,
     range: Option<[f64; 2]>,
@@ -336,53 +397,20 @@ struct ChartData<'a> {
 /// What a chart shows before it is drawn: the traces reduced to the columns
 /// of its plot, the angle bounds and the y-axis tick labels.
 struct Frame_ {
-    raw: Vec<(f64, f64)>,
+    /// The raw trace: one line, or the lower and upper lines of its
+    /// envelope where the view holds more samples than the plot has dots.
+    raw: Vec<Vec<(f64, f64)>>,
     /// The optical reference's points (finite ones only).
     reference: Vec<(f64, f64)>,
-    cor: Vec<(f64, f64)>,
+    /// The corrected trace, as `raw`.
+    cor: Vec<Vec<(f64, f64)>>,
+    /// The extrapolated part of the corrected trace (a growing trial's), as `raw`.
+    ext: Vec<Vec<(f64, f64)>>,
     /// Angle bounds of the plot, degrees.
     lo: f64,
     hi: f64,
     /// (value, label) of the round ticks inside the bounds.
     labels: Vec<(f64, String)>,
-}
-
-/// Round tick values inside `[lo, hi]`: multiples of a step of 1, 2 or 5
-/// times a power of ten, at most `max` of them (at least one step is tried
-/// until few enough fit; none when the bounds are not finite).
-pub fn ticks(lo: f64, hi: f64, max: usize) -> (f64, Vec<f64>) {
-    let max = max.max(1);
-    if !(lo.is_finite() && hi.is_finite()) || hi <= lo {
-        return (1.0, vec![]);
-    }
-    let mut decade = 10f64.powf(((hi - lo) / max as f64).log10().floor());
-    loop {
-        for m in [1.0, 2.0, 5.0] {
-            let step = decade * m;
-            let (first, last) = ((lo / step).ceil() as i64, (hi / step).floor() as i64);
-            if last < first || ((last - first + 1) as usize) <= max {
-                // `+ 0.0` turns -0 into 0.
-                let vals = (first..=last).map(|k| k as f64 * step + 0.0).collect();
-                return (step, vals);
-            }
-        }
-        decade *= 10.0;
-    }
-}
-
-/// A tick label: the value with as many decimals as the step needs, and the
-/// unit (degrees; ASCII charts name it in the title instead).
-fn tick_label(v: f64, step: f64, ascii: bool) -> String {
-    let decimals = (-step.log10().floor()).max(0.0) as usize;
-    let unit = if ascii { "" } else { "°" };
-    format!("{v:.decimals$}{unit}")
-}
-
-/// The row of `v` in a plot `height` rows tall over `[lo, hi]`, from the top
-/// (as the chart's one-per-cell markers place it).
-fn row_of(v: f64, lo: f64, hi: f64, height: u16) -> u16 {
-    let h = f64::from(height.saturating_sub(1));
-    ((hi - v) * h / (hi - lo)).round().clamp(0.0, h) as u16
 }
 
 /// The plot's content and axis for a chart in `area` (None when too small).
@@ -403,10 +431,15 @@ fn frame_of(d: &ChartData, area: Rect, ascii: bool) -> Option<Frame_> {
         s1,
         cols * raw_per_col,
     );
-    let cor = d
-        .cor
-        .map(|c| envelope(d.t, d.origin, |i| c[i][d.axis], s0, s1, cols))
-        .unwrap_or_default();
+    // A growing trial's correction in two parts: solved, then extrapolated.
+    let k = d.solved.unwrap_or(d.t.len()).min(d.t.len());
+    let (cor, ext) = match d.cor {
+        Some(c) => (
+            envelope(&d.t[..k], d.origin, |i| c[i][d.axis], s0, s1, cols),
+            envelope(&d.t[k..], d.origin, |i| c[k + i][d.axis], s0, s1, cols),
+        ),
+        None => (vec![], vec![]),
+    };
     let reference: Vec<(f64, f64)> = d
         .reference
         .map(|r| envelope(d.t, d.origin, |i| r[i], s0, s1, cols))
@@ -417,7 +450,7 @@ fn frame_of(d: &ChartData, area: Rect, ascii: bool) -> Option<Frame_> {
     // Bounds: the data in view and the limits.
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
-    for &(_, y) in raw.iter().chain(cor.iter()).chain(reference.iter()) {
+    for &(_, y) in raw.iter().chain(&cor).chain(&ext).chain(&reference) {
         lo = lo.min(y);
         hi = hi.max(y);
     }
@@ -431,21 +464,48 @@ fn frame_of(d: &ChartData, area: Rect, ascii: bool) -> Option<Frame_> {
     }
     let pad = ((hi - lo) * 0.05).max(0.5);
     let (lo, hi) = (lo - pad, hi + pad);
-    // A tick at most every other row.
-    let plot_h = area.height.saturating_sub(1) as usize;
-    let (step, vals) = ticks(lo, hi, plot_h.div_ceil(2).clamp(1, 5));
-    let labels = vals
-        .into_iter()
-        .map(|v| (v, tick_label(v, step, ascii)))
-        .collect();
+    let (_, plot_h) = axis::plot_rows(area, false);
+    let labels = axis::y_labels(lo, hi, plot_h, if ascii { "" } else { "°" });
     Some(Frame_ {
-        raw,
+        raw: outline(raw),
         reference,
-        cor,
+        cor: outline(cor),
+        ext: outline(ext),
         lo,
         hi,
         labels,
     })
+}
+
+/// An [`envelope`]'s points as lines to draw: as they are when it kept the
+/// samples (each time once), else its lower and its upper line (one point
+/// per column each). Joining a column's minimum to its maximum would fill
+/// the plot solid wherever the angle swings faster than a column is wide
+/// (a 300 s trace over 100 columns); the two lines keep it a trace, and
+/// the band between them shows the swing.
+fn outline(points: Vec<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
+    if points.is_empty() {
+        return vec![];
+    }
+    if points.windows(2).all(|w| w[0].0 != w[1].0) {
+        return vec![points];
+    }
+    let mut lower: Vec<(f64, f64)> = vec![];
+    let mut upper: Vec<(f64, f64)> = vec![];
+    for p in points {
+        match lower.last_mut() {
+            Some(l) if l.0 == p.0 => {
+                let u = upper.last_mut().expect("pushed together");
+                l.1 = l.1.min(p.1);
+                u.1 = u.1.max(p.1);
+            }
+            _ => {
+                lower.push(p);
+                upper.push(p);
+            }
+        }
+    }
+    vec![lower, upper]
 }
 
 fn chart(
@@ -479,9 +539,14 @@ fn chart(
     if d.cursor >= s0 && d.cursor <= s1 {
         sets.push(line(&cursor, theme.cursor, g.cursor));
     }
-    sets.push(line(&fr.raw, theme.raw, g.raw));
-    if !fr.cor.is_empty() {
-        sets.push(line(&fr.cor, theme.corrected, g.corrected));
+    for l in &fr.raw {
+        sets.push(line(l, theme.raw, g.raw));
+    }
+    for l in &fr.cor {
+        sets.push(line(l, theme.corrected, g.corrected));
+    }
+    for l in &fr.ext {
+        sets.push(line(l, theme.corrected, g.extrapolated));
     }
     // The reference as points of its own glyph (named `ref` in the title and
     // the legend), so it reads apart from raw and corrected without colour.
@@ -507,32 +572,26 @@ fn chart(
     // Blank labels of the common width keep the plot where the other charts
     // have theirs; the round ticks are written at their own rows below.
     let label_w = label_w.min(area.width / 3);
-    let blank = " ".repeat(label_w as usize);
     let chart = Chart::new(sets)
         .block(Block::new().borders(Borders::TOP).title(title))
         .x_axis(Axis::default().bounds([s0, s1]))
         .y_axis(
             Axis::default()
                 .bounds([lo, hi])
-                .labels(vec![blank.clone(), blank])
+                .labels(axis::blank(label_w))
                 .style(theme.dim),
         )
         .legend_position(None);
     f.render_widget(chart, area);
-    let plot_h = area.height.saturating_sub(1);
-    let buf = f.buffer_mut();
-    for (v, label) in &fr.labels {
-        let y = area.y + 1 + row_of(*v, lo, hi, plot_h);
-        // Right-aligned; a label wider than the column loses its left end.
-        let w = label_w as usize;
-        let n = label.chars().count();
-        let text: String = if n > w {
-            label.chars().skip(n - w).collect()
-        } else {
-            format!("{label:>w$}")
-        };
-        buf.set_string(area.x, y, text, theme.dim);
-    }
+    axis::draw_labels(
+        f.buffer_mut(),
+        area.x,
+        axis::plot_rows(area, false),
+        label_w,
+        (lo, hi),
+        &fr.labels,
+        theme.dim,
+    );
 }
 
 fn figures_panel(
@@ -603,8 +662,31 @@ pub fn open(app: &mut Workbench, file: String) {
             ..View::default()
         };
     }
+    // A growing trial opens at its newest sample, and follows it.
+    if let Some(l) = app
+        .entry(&file)
+        .filter(|e| e.live.is_some())
+        .and_then(|e| e.loaded())
+    {
+        app.view.cursor_s = l.trial.duration_s();
+    }
     app.select_file(&file);
     app.open = Some(file);
+}
+
+/// The open trial grew from `before` to `after` seconds: a view showing its
+/// end keeps showing it (the time axis scrolls with the data), and a cursor
+/// on its last sample stays on the last sample.
+pub fn grown(app: &mut Workbench, before: f64, after: f64) {
+    let eps = 1e-9;
+    let (_, end) = app.view.span(before);
+    if end >= before - eps {
+        let (a, b) = app.view.span(after);
+        app.view.start_s = (after - (b - a)).max(0.0);
+    }
+    if app.view.cursor_s >= before - eps {
+        app.view.cursor_s = after;
+    }
 }
 
 /// What a key does on the trial screen.

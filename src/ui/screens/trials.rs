@@ -1,7 +1,7 @@
 //! The trials screen: every trial file of the folder, its status and figures.
 
 use crate::acm::Variant;
-use crate::ui::cells::{counter, fit, list_move, num, sel};
+use crate::ui::cells::{abbreviate, counter, fit, list_move, num, sel};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Nav, Reply};
 use crate::ui::theme::Theme;
@@ -123,11 +123,11 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
         let marker = if selected { "> " } else { "  " };
         let line = match &e.load {
             LoadState::Pending => Line::from(vec![
-                Span::raw(format!("{marker}{}", fit(&e.file, nw))),
+                Span::raw(format!("{marker}{}", abbreviate(&e.file, nw))),
                 Span::styled("  loading...", theme.dim),
             ]),
             LoadState::Failed(m) => Line::from(vec![
-                Span::raw(format!("{marker}{}", fit(&e.file, nw))),
+                Span::raw(format!("{marker}{}", abbreviate(&e.file, nw))),
                 Span::styled(
                     format!("  ERR {}", fit(m, fixed.saturating_sub(6))),
                     theme.error,
@@ -136,7 +136,7 @@ pub fn render(app: &Workbench, theme: &Theme, f: &mut Frame, area: Rect) {
             LoadState::Loaded(l) => {
                 let mut s = format!(
                     "{marker}{}{:>8.1}{:>6.0}{:>5}",
-                    fit(&e.file, nw),
+                    abbreviate(&e.file, nw),
                     l.trial.duration_s(),
                     l.trial.rate_hz(),
                     l.trial.imus.len()

@@ -6,6 +6,7 @@
 use super::Ctx;
 use super::{colour, marker};
 use crate::analysis::applied::AppliedCorrection;
+use crate::ui::axis;
 use crate::ui::theme::Theme;
 use crate::ui::workbench::TrialEntry;
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -25,16 +26,28 @@ fn bounds(ys: impl Iterator<Item = f64>) -> [f64; 2] {
     [lo - pad, hi + pad]
 }
 
-fn labels(b: [f64; 2], h: u16) -> Vec<String> {
-    if h >= 7 {
-        vec![
-            format!("{:.1}", b[0]),
-            format!("{:.1}", (b[0] + b[1]) / 2.0),
-            format!("{:.1}", b[1]),
-        ]
-    } else {
-        vec![format!("{:.1}", b[0]), format!("{:.1}", b[1])]
-    }
+/// A chart in `area` whose y axis over `b` has round ticks in degrees.
+fn chart_with_ticks(f: &mut Frame, chart: Chart, area: Rect, b: [f64; 2], theme: &Theme) {
+    let unit = if theme.ascii { "" } else { "°" };
+    let plot = axis::plot_rows(area, false);
+    let labels = axis::y_labels(b[0], b[1], plot.1, unit);
+    let w = axis::width(&labels).min(area.width / 3);
+    let chart = chart.y_axis(
+        Axis::default()
+            .bounds(b)
+            .labels(axis::blank(w))
+            .style(theme.dim),
+    );
+    f.render_widget(chart, area);
+    axis::draw_labels(
+        f.buffer_mut(),
+        area.x,
+        plot,
+        w,
+        (b[0], b[1]),
+        &labels,
+        theme.dim,
+    );
 }
 
 pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rect) {
@@ -118,18 +131,15 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
         Span::styled(" angle, deg ", theme.header),
         Span::styled(format!("• {} window centres ", centres.len()), centre_style),
     ]);
-    f.render_widget(
+    chart_with_ticks(
+        f,
         Chart::new(sets)
             .block(Block::new().borders(Borders::TOP).title(title))
             .x_axis(x_axis.clone())
-            .y_axis(
-                Axis::default()
-                    .bounds(ba)
-                    .labels(labels(ba, top.height))
-                    .style(theme.dim),
-            )
             .legend_position(None),
         top,
+        ba,
+        theme,
     );
     // Components.
     let axis_colours = [Color::LightRed, Color::LightGreen, Color::LightBlue];
@@ -176,18 +186,15 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
                 .add_modifier(ratatui::style::Modifier::BOLD),
         ));
     }
-    f.render_widget(
+    chart_with_ticks(
+        f,
         Chart::new(sets)
             .block(Block::new().borders(Borders::TOP).title(Line::from(title)))
             .x_axis(x_axis)
-            .y_axis(
-                Axis::default()
-                    .bounds(bc)
-                    .labels(labels(bc, bottom.height))
-                    .style(theme.dim),
-            )
             .legend_position(None),
         bottom,
+        bc,
+        theme,
     );
     let (lo, hi) = angle
         .iter()

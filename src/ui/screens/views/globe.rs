@@ -77,6 +77,7 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
     .areas(area);
     let [left, right] = Layout::horizontal([Constraint::Ratio(1, 2); 2]).areas(panels);
     let mk = marker(app, theme);
+    let outline = theme.glyphs(app.view.braille).outline;
     let keys = key_markers(app, theme, c == Colouring::Time);
     // Zoom to the band and the samples (the thesis' plots show that region).
     let mut outlines = vec![band_outline(&range, axes, 24)];
@@ -141,6 +142,9 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
             .x_bounds(bx)
             .y_bounds(by)
             .paint(|ctx| {
+                if outline != mk {
+                    ctx.marker(outline);
+                }
                 ctx.draw(&Circle {
                     x: 0.0,
                     y: 0.0,
@@ -154,6 +158,9 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
                     colours: &[band_colour],
                 });
                 ctx.layer();
+                if outline != mk {
+                    ctx.marker(mk);
+                }
                 if let Some(r) = &raster {
                     draw_keys(ctx, r, &colours, &keys, mk);
                 }

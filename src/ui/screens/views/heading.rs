@@ -4,6 +4,7 @@
 
 use super::Ctx;
 use crate::acm::{ImuHeading, Variant};
+use crate::ui::axis;
 use crate::ui::cells::fit;
 use crate::ui::glyphs::SERIES;
 use crate::ui::theme::Theme;
@@ -136,6 +137,10 @@ fn chart(hs: &[&ImuHeading], duration: f64, theme: &Theme, f: &mut Frame, area: 
                 .style(st[k % st.len()]),
         );
     }
+    let unit = if theme.ascii { "" } else { "°" };
+    let plot = axis::plot_rows(area, true);
+    let labels = axis::y_labels(lo, hi, plot.1, unit);
+    let w = axis::width(&labels).min(area.width / 3);
     let chart = Chart::new(sets)
         .block(Block::new().borders(Borders::TOP).title("deg"))
         .x_axis(
@@ -147,11 +152,20 @@ fn chart(hs: &[&ImuHeading], duration: f64, theme: &Theme, f: &mut Frame, area: 
         .y_axis(
             Axis::default()
                 .bounds([lo, hi])
-                .labels(vec![format!("{lo:.0}"), format!("{hi:.0}")])
+                .labels(axis::blank(w))
                 .style(theme.dim),
         )
         .legend_position(None);
     f.render_widget(chart, area);
+    axis::draw_labels(
+        f.buffer_mut(),
+        area.x,
+        plot,
+        w,
+        (lo, hi),
+        &labels,
+        theme.dim,
+    );
 }
 
 /// The largest window-to-window rate of an IMU (deg/s) and the centre it ends at.
