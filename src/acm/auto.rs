@@ -30,9 +30,9 @@
 //! [`MARGIN_DEG`] of the lowest score (and not above `none`'s) count as
 //! tied, and the first of them in [`CANDIDATES`] order is taken.
 
+use super::cost::excursion;
 use super::{ImuHeading, WindowSolution};
 use crate::limits::JointLimits;
-use crate::metrics::excursion_figures;
 use crate::model::Joint;
 use crate::rotation::{angle_deg, quat_from_wxyz, wrap180, Quat};
 use crate::variant::Variant;
@@ -236,15 +236,28 @@ fn decide(figures: &[CandidateFigures], angles: &[Vec<[f64; 3]>]) -> Choice {
     }
 }
 
+/// Mean over samples of the summed excursion beyond `range_deg` of the three
+/// angles, degrees (summed per axis first, as the report's figure is).
+fn joint_mean_excursion_deg(angles: &[[f64; 3]], range_deg: &[[f64; 2]; 3]) -> f64 {
+    let mut sum = [0.0; 3];
+    for a in angles {
+        for (s, e) in sum.iter_mut().zip(excursion(*a, range_deg)) {
+            *s += e;
+        }
+    }
+    sum.iter().sum::<f64>() / angles.len().max(1) as f64
+}
+
 fn figures_of(
     j: &JointCandidates,
     i: usize,
     c: &Candidate,
     angles: &[Vec<[f64; 3]>],
 ) -> CandidateFigures {
-    let excursion_deg = j.limits.as_ref().map_or(0.0, |l| {
-        excursion_figures(&angles[i], l).joint_mean_excursion_deg
-    });
+    let excursion_deg = j
+        .limits
+        .as_ref()
+        .map_or(0.0, |l| joint_mean_excursion_deg(&angles[i], &l.range_deg));
     let n = j.raw.len().max(1) as f64;
     let correction_deg = j
         .raw
