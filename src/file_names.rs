@@ -35,13 +35,6 @@ pub fn stem_without(path: &Path, suffixes: &[&str]) -> String {
     name[..stem_len].to_string()
 }
 
-/// True when `path`'s name is a plain (uncompressed) CSV's, `.csv` in any
-/// case: the trials that can be read while another program appends to them.
-pub fn is_plain_csv_name(path: &Path) -> bool {
-    path.file_name()
-        .is_some_and(|n| n.to_string_lossy().to_ascii_lowercase().ends_with(".csv"))
-}
-
 /// True when `path`'s name could be an OpenSense mapping: it ends in `.xml`
 /// (any case). Its content decides whether it is one.
 pub fn is_mapping_name(path: &Path) -> bool {

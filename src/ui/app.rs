@@ -125,7 +125,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                     app.sort_trials();
                 }
             }
-            if crate::file_names::is_plain_csv_name(&path) {
+            if crate::trial::format::is_followable_name(&path) {
                 // A CSV trial that changes may be growing: followed as it
                 // grows, read whole once it stops.
                 return app.follow_effect(&file).into_iter().collect();
