@@ -5,6 +5,7 @@
 
 mod common;
 
+use acm_workbench::batch::journal;
 use acm_workbench::batch::manifest::{Manifest, Status};
 use acm_workbench::simulate::{simulate, HeadingDrift, SimConfig};
 use acm_workbench::trial::{write_trial, TrialFormat};
@@ -142,7 +143,7 @@ fn a_batch_killed_half_way_finishes_without_redoing_done_trials() {
     // Kill it once three trials are recorded.
     let start = Instant::now();
     let stalled = loop {
-        let rows = Manifest::load(&out.join("manifest.json")).map_or(0, |m| m.rows.len());
+        let rows = journal::recorded(&out.join("manifest.json")).map_or(0, |r| r.len());
         if rows >= 3 || start.elapsed() > Duration::from_secs(300) {
             break rows < 3;
         }
@@ -151,15 +152,16 @@ fn a_batch_killed_half_way_finishes_without_redoing_done_trials() {
     let _ = child.kill();
     child.wait().unwrap();
     assert!(!stalled, "batch stalled");
-    let done_before = Manifest::load(&out.join("manifest.json")).unwrap();
-    let done = done_before.rows.len();
+    // What the killed run recorded: its manifest (rewritten now and then)
+    // and the journal of the trials finished since.
+    let done_before = journal::recorded(&out.join("manifest.json")).unwrap();
+    let done = done_before.len();
     assert!(
         done < n as usize,
         "killed before the end ({done} of {n} done)"
     );
-    assert!(done_before.rows.iter().all(|r| r.status == Status::Ok));
+    assert!(done_before.iter().all(|r| r.status == Status::Ok));
     let mtimes: Vec<(PathBuf, SystemTime)> = done_before
-        .rows
         .iter()
         .flat_map(|r| [dir.path().join(&r.output), dir.path().join(&r.sidecar)])
         .map(|p| {
@@ -192,7 +194,7 @@ fn a_batch_killed_half_way_finishes_without_redoing_done_trials() {
         );
     }
     // The rows of the done trials are those of the first run, untouched.
-    for r in &done_before.rows {
+    for r in &done_before {
         assert!(after.rows.contains(r));
     }
     // A trial whose input changed is done again; the others are not.

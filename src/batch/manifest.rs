@@ -406,15 +406,22 @@ impl Manifest {
             path: dir.display().to_string(),
             message: e.to_string(),
         })?;
-        let mut paths: Vec<PathBuf> = rd
-            .filter_map(|e| e.ok())
-            .map(|e| e.path())
-            .filter(|p| {
-                p.file_name()
-                    .map(|n| n.to_string_lossy())
-                    .is_some_and(|n| n.starts_with("manifest.shard-") && n.ends_with(".json"))
-            })
-            .collect();
+        let shard_file = |p: &Path, end: &str| {
+            p.file_name()
+                .map(|n| n.to_string_lossy())
+                .is_some_and(|n| n.starts_with("manifest.shard-") && n.ends_with(end))
+        };
+        let all: Vec<PathBuf> = rd.filter_map(|e| e.ok()).map(|e| e.path()).collect();
+        // A shard's journal outlives its run only when the run was killed (or
+        // still runs): its manifest then lacks trials the journal holds.
+        if let Some(j) = all.iter().find(|p| shard_file(p, ".journal.jsonl")) {
+            return Err(ManifestError::Merge(format!(
+                "{} exists: that shard was stopped before its end or is still running; \
+                 run it again (it resumes) before merging",
+                j.display()
+            )));
+        }
+        let mut paths: Vec<PathBuf> = all.into_iter().filter(|p| shard_file(p, ".json")).collect();
         paths.sort();
         paths.iter().map(|p| Manifest::load(p)).collect()
     }
@@ -511,5 +518,19 @@ mod tests {
         let json = serde_json::to_string(&m).unwrap();
         let back: Manifest = serde_json::from_str(&json).unwrap();
         assert_eq!(back, m);
+    }
+
+    #[test]
+    fn shards_are_not_merged_while_one_has_a_journal() {
+        let dir = tempfile::tempdir().unwrap();
+        let journal = dir.path().join("manifest.shard-2-of-4.journal.jsonl");
+        std::fs::write(&journal, "").unwrap();
+        let e = Manifest::load_shards(dir.path()).unwrap_err().to_string();
+        assert!(
+            e.contains("manifest.shard-2-of-4.journal.jsonl exists"),
+            "{e}"
+        );
+        std::fs::remove_file(&journal).unwrap();
+        assert!(Manifest::load_shards(dir.path()).unwrap().is_empty());
     }
 }

@@ -9,6 +9,7 @@
 //! not depend on the number of workers, nor on how the list is sharded.
 //! Nothing here prints: progress comes back through [`Event`]s.
 
+pub mod journal;
 pub mod manifest;
 
 use crate::acm::RunControl;
@@ -19,12 +20,60 @@ use crate::model::Model;
 use crate::sidecar::sidecar_path;
 use crate::trial::{detect_format, is_trial_path, TrialFormat};
 use crate::variant::Variant;
+use journal::Journal;
 use manifest::{Manifest, Row, Status};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
+
+/// The manifest being built by a run: its header, its rows by trial and
+/// variant (kept in manifest order), and when it is next rewritten whole.
+struct Record {
+    header: Manifest,
+    rows: std::collections::BTreeMap<(String, Variant), Row>,
+    pace: journal::SavePace,
+}
+
+impl Record {
+    /// Replaces the rows of `trial` by `rows`, rewriting the manifest when
+    /// its pace says so.
+    fn insert(
+        &mut self,
+        trial: &Path,
+        rows: &[Row],
+        out_dir: &Path,
+    ) -> Result<(), crate::save::WriteError> {
+        let name = trial.display().to_string();
+        for &v in &self.header.variants {
+            self.rows.remove(&(name.clone(), v));
+        }
+        for r in rows {
+            self.rows.insert((r.trial.clone(), r.variant), r.clone());
+        }
+        if self.pace.due() {
+            self.save(out_dir)?;
+        }
+        Ok(())
+    }
+
+    /// The manifest as it stands.
+    fn manifest(&self) -> Manifest {
+        Manifest {
+            rows: self.rows.values().cloned().collect(),
+            ..self.header.clone()
+        }
+    }
+
+    /// Writes the manifest (JSON and CSV) atomically.
+    fn save(&mut self, out_dir: &Path) -> Result<(), crate::save::WriteError> {
+        let started = Instant::now();
+        self.manifest().save(out_dir)?;
+        self.pace.saved(started);
+        Ok(())
+    }
+}
 
 /// One of `count` parts of a trial list (`index` from 1 to `count`).
 ///
@@ -278,33 +327,54 @@ impl Batch<'_> {
         let json = self.out_dir.join(Manifest::file_name(self.shard, "json"));
         let _lock = crate::save::OutputLock::acquire(&json)
             .map_err(|e| BatchError::Lock(format!("{}: {e}", json.display())))?;
-        let earlier: HashMap<(String, Variant), Row> = if json.is_file() {
-            Manifest::load(&json)?
-                .rows
-                .into_iter()
-                .map(|r| ((r.trial.clone(), r.variant), r))
-                .collect()
-        } else {
-            HashMap::new()
-        };
+        let journal_path = Journal::path_for(&json);
+        let mut earlier: HashMap<(String, Variant), Row> = HashMap::new();
+        if json.is_file() {
+            for r in Manifest::load(&json)?.rows {
+                earlier.insert((r.trial.clone(), r.variant), r);
+            }
+        }
+        // The journal holds what was done after the manifest was last
+        // written; its rows are the newer ones.
+        let journaled = journal::read(&journal_path)?;
+        let had_journal = journal_path.exists();
+        for r in journaled {
+            earlier.insert((r.trial.clone(), r.variant), r);
+        }
         let names: std::collections::HashSet<String> =
             trials.iter().map(|t| t.display().to_string()).collect();
-        let manifest = Mutex::new(Manifest {
-            program: "acmw".into(),
-            version: env!("CARGO_PKG_VERSION").into(),
-            shard: self.shard,
-            variants: self.variants.to_vec(),
-            settings: *self.settings,
-            limits_source: self.limits_source.to_string(),
-            limits_sha256: self.limits.hash(),
+        let mut record = Record {
+            header: Manifest {
+                program: "acmw".into(),
+                version: env!("CARGO_PKG_VERSION").into(),
+                shard: self.shard,
+                variants: self.variants.to_vec(),
+                settings: *self.settings,
+                limits_source: self.limits_source.to_string(),
+                limits_sha256: self.limits.hash(),
+                rows: Vec::new(),
+            },
             // Until a trial is looked at again, its earlier rows stand (a run
             // killed early loses nothing an earlier run recorded).
             rows: (earlier.values())
                 .filter(|r| names.contains(&r.trial))
                 .filter(|r| self.variants.contains(&r.variant))
-                .cloned()
+                .map(|r| ((r.trial.clone(), r.variant), r.clone()))
                 .collect(),
-        });
+            pace: journal::SavePace::new(),
+        };
+        let manifest_error = |e: crate::save::WriteError| BatchError::Manifest(e.into());
+        let journal_error = |e: std::io::Error| {
+            BatchError::Manifest(crate::save::WriteError::io(&journal_path, &e).into())
+        };
+        if had_journal {
+            // Fold the journal into the manifest, then start a fresh one (no
+            // line is ever appended after one a kill cut short).
+            record.save(self.out_dir).map_err(manifest_error)?;
+        }
+        let _ = std::fs::remove_file(&journal_path);
+        let journal = Journal::open(&journal_path).map_err(journal_error)?;
+        let shared = Mutex::new((record, journal));
         observe(Event::Started {
             trials: trials.len(),
         });
@@ -323,17 +393,18 @@ impl Batch<'_> {
                     return;
                 }
                 let (rows, resumed) = self.trial(trial, &earlier);
-                let mut m = manifest.lock().expect("not poisoned");
-                let name = trial.display().to_string();
-                m.rows.retain(|r| r.trial != name);
-                m.rows.extend(rows.iter().cloned());
-                m.sort();
-                if let Err(e) = m.save(self.out_dir) {
-                    *write_error.lock().expect("not poisoned") =
-                        Some(BatchError::Manifest(e.into()));
+                let mut guard = shared.lock().expect("not poisoned");
+                let (record, journal) = &mut *guard;
+                let written = journal.append(&rows).map_err(journal_error).and_then(|()| {
+                    record
+                        .insert(trial, &rows, self.out_dir)
+                        .map_err(manifest_error)
+                });
+                if let Err(e) = written {
+                    *write_error.lock().expect("not poisoned") = Some(e);
                     return;
                 }
-                drop(m);
+                drop(guard);
                 observe(Event::Finished {
                     rows: &rows,
                     resumed,
@@ -343,14 +414,10 @@ impl Batch<'_> {
         if let Some(e) = write_error.into_inner().expect("not poisoned") {
             return Err(e);
         }
-        let mut m = manifest.into_inner().expect("not poisoned");
-        m.sort();
-        if trials.is_empty() {
-            m.save(self.out_dir)
-                .map_err(|e| BatchError::Manifest(e.into()))?;
-        }
-        m.sort();
-        Ok(m)
+        let (mut record, journal) = shared.into_inner().expect("not poisoned");
+        record.save(self.out_dir).map_err(manifest_error)?;
+        journal.remove().map_err(journal_error)?;
+        Ok(record.manifest())
     }
 
     /// One trial: its rows, and whether all were taken from `earlier`.
