@@ -311,11 +311,24 @@ fn auto_on_24_held_out_trials() {
     assert_targets(&f);
 }
 
-/// The tuning set, for `ACMW_AUTO_TRACE=1` runs while tuning (not asserted).
+/// The tuning set, for `ACMW_AUTO_TRACE=1` runs while tuning (not asserted);
+/// `ACMW_AUTO_SEEDS=FIRST-LAST` picks other seeds (never the held-out ones).
 #[test]
 #[ignore = "tuning aid"]
 fn auto_tuning_trace() {
-    let seeds: Vec<u64> = TUNING_SEEDS.collect();
+    let seeds: Vec<u64> = match std::env::var("ACMW_AUTO_SEEDS") {
+        Ok(range) => {
+            let (a, b) = range.split_once('-').expect("ACMW_AUTO_SEEDS=FIRST-LAST");
+            (a.parse().expect("a seed")..=b.parse().expect("a seed")).collect()
+        }
+        Err(_) => TUNING_SEEDS.collect(),
+    };
+    assert!(
+        seeds
+            .iter()
+            .all(|s| !(101..=106).contains(s) && !(201..=224).contains(s)),
+        "held-out seeds are never tuned on"
+    );
     let f = evaluate(&seeds, 120.0);
     f.print("tuning seeds");
 }

@@ -942,10 +942,13 @@ fn solve_windows(
     control: &RunControl,
     progress: &(dyn Fn() + Sync),
 ) -> Result<JointSolution, Cancelled> {
-    let costs: Vec<WindowCost> = windows
-        .iter()
-        .map(|w| WindowCost::new(&measured[w.first..w.end], limits, lambda1))
-        .collect();
+    // A window's cost holds a copy of its samples laid out for the loop: it
+    // is built where the window is solved and dropped after, so only the
+    // windows being solved at once hold one (peak memory).
+    let cost_of = |k: usize| {
+        let w = &windows[k];
+        WindowCost::new(&measured[w.first..w.end], limits, lambda1)
+    };
     // Pass 1: every window from identity, in parallel. Windows solved on the
     // same samples (thin windows in a long gap all borrow one span) have one
     // solution, found once.
@@ -967,7 +970,7 @@ fn solve_windows(
             if control.cancelled() {
                 return Err(Cancelled);
             }
-            let s = solve_window(&costs[k], &[Quat::identity()], solver);
+            let s = solve_window(&cost_of(k), &[Quat::identity()], solver);
             progress();
             Ok(s)
         })
@@ -975,35 +978,37 @@ fn solve_windows(
     (distinct.len()..windows.len()).for_each(|_| progress());
     let first: Vec<Solution> = slot.iter().map(|&u| solved[u]).collect();
     // Pass 2: where a neighbour's solution is cheaper here, descend from it.
-    let second: Vec<Solution> = (0..costs.len())
+    // Each window's solution and its cost uncorrected.
+    let second: Vec<(Solution, f64)> = (0..windows.len())
         .into_par_iter()
         .map(|k| {
-            let cost = &costs[k];
+            let cost = cost_of(k);
+            let uncorrected = cost.eval(&Quat::identity());
             let neighbours = [k.wrapping_sub(1), k + 1]
                 .into_iter()
-                .filter(|&n| n < costs.len())
+                .filter(|&n| n < windows.len())
                 .map(|n| first[n].c)
                 .filter(|c| cost.eval(c) < first[k].cost - 1e-12)
                 .collect::<Vec<_>>();
             if neighbours.is_empty() {
-                return first[k];
+                return (first[k], uncorrected);
             }
-            let s = solve_window(cost, &neighbours, solver);
-            if s.cost < first[k].cost {
+            let s = solve_window(&cost, &neighbours, solver);
+            let best = if s.cost < first[k].cost {
                 Solution {
                     evaluations: s.evaluations + first[k].evaluations,
                     ..s
                 }
             } else {
                 first[k]
-            }
+            };
+            (best, uncorrected)
         })
         .collect();
     let solutions: Vec<WindowSolution> = windows
         .iter()
-        .zip(&costs)
         .zip(&second)
-        .map(|((w, cost), s)| {
+        .map(|(w, (s, uncorrected))| {
             let c = canonical(&s.c);
             WindowSolution {
                 start_s: w.start_s,
@@ -1013,7 +1018,7 @@ fn solve_windows(
                 correction: wxyz(&c),
                 angle_deg: angle_deg(&c),
                 cost: s.cost,
-                cost_uncorrected: cost.eval(&Quat::identity()),
+                cost_uncorrected: *uncorrected,
                 evaluations: s.evaluations,
             }
         })
