@@ -20,14 +20,15 @@
 //! test runs 6 held-out trials of 120 s; `benches/auto_eval.sh` runs the
 //! ignored test on 24 held-out trials of 120 s.
 
-use acm_workbench::acm::{Correction, RunControl, Variant};
-use acm_workbench::correct::correct_trial;
-use acm_workbench::limits::{LimitTable, Settings};
+mod common;
+
+use acm_workbench::acm::{Correction, Variant};
 use acm_workbench::metrics::{joint_angles, truth_figures};
 use acm_workbench::model::Model;
 use acm_workbench::simulate::{
     simulate, HeadingDrift, Misalignment, SensorSlip, SimConfig, SimKind, Simulated,
 };
+use common::engine::{median, run};
 
 /// The seeds `acm::auto`'s weights were tuned on (never evaluated here).
 pub const TUNING_SEEDS: std::ops::RangeInclusive<u64> = 1..=12;
@@ -116,18 +117,6 @@ fn scenario(seed: u64, duration_s: f64) -> SimConfig {
     c
 }
 
-fn run(sim: &Simulated, variant: Variant) -> Correction {
-    correct_trial(
-        &sim.trial,
-        &Model::infant13(),
-        &LimitTable::default_table(),
-        &Settings::default(),
-        variant,
-        &RunControl::default(),
-    )
-    .unwrap()
-}
-
 /// Per joint of `infant13`, the RMS error of its three angles against truth, degrees.
 fn joint_errors(sim: &Simulated, c: &Correction) -> Vec<f64> {
     let model = Model::infant13();
@@ -142,16 +131,6 @@ fn joint_errors(sim: &Simulated, c: &Correction) -> Vec<f64> {
             (f.rms_error_deg.iter().map(|e| e * e).sum::<f64>() / 3.0).sqrt()
         })
         .collect()
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 /// Per method (the singles, `auto`, `hindsight`): per trial (median joint, worst joint).
@@ -189,9 +168,9 @@ fn evaluate(seeds: &[u64], duration_s: f64) -> Figures {
         let sim = simulate(&scenario(seed, duration_s)).unwrap();
         let singles: Vec<Vec<f64>> = SINGLES
             .iter()
-            .map(|&v| joint_errors(&sim, &run(&sim, v)))
+            .map(|&v| joint_errors(&sim, &run(&sim.trial, v)))
             .collect();
-        let auto = run(&sim, Variant::Auto);
+        let auto = run(&sim.trial, Variant::Auto);
         check_choices(&auto);
         let auto_errors = joint_errors(&sim, &auto);
         let hindsight: Vec<f64> = (0..auto_errors.len())
@@ -238,7 +217,7 @@ fn check_choices(auto: &Correction) {
 fn trace(seed: u64, sim: &Simulated, auto: &Correction) {
     let runs: Vec<Vec<f64>> = SINGLES
         .iter()
-        .map(|&v| joint_errors(sim, &run(sim, v)))
+        .map(|&v| joint_errors(sim, &run(&sim.trial, v)))
         .collect();
     let model = Model::infant13();
     for (j, joint) in model.joints.iter().enumerate() {

@@ -6,35 +6,20 @@
 //! corrects the ab/adduction (Z) and rotation (X) of the Z-Y-X angles and keeps
 //! flexion (Y) as measured; the ACM corrects the calf IMU only.
 
-use acm_workbench::acm::{Correction, RunControl, Variant};
+mod common;
+
+use acm_workbench::acm::Variant;
 use acm_workbench::baselines::mueller::angle_between_axes_deg;
 use acm_workbench::baselines::BaselineRecord;
-use acm_workbench::correct::correct_trial;
-use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::metrics::joint_angles;
 use acm_workbench::model::Model;
-use acm_workbench::rotation::{angle_between_deg, wrap180, Quat};
+use acm_workbench::rotation::wrap180;
 use acm_workbench::simulate::{
     simulate, simulate_with, ImuMisalignment, KneeAxis, KneeImu, Misalignment, SimConfig, Simulated,
 };
 use acm_workbench::trial::Trial;
+use common::engine::{geodesic_error_deg, run, run_on};
 use nalgebra::Vector3;
-
-fn run(trial: &Trial, variant: Variant) -> Correction {
-    run_on(&Model::infant13(), trial, variant)
-}
-
-fn run_on(model: &Model, trial: &Trial, variant: Variant) -> Correction {
-    correct_trial(
-        trial,
-        model,
-        &LimitTable::default_table(),
-        &Settings::default(),
-        variant,
-        &RunControl::default(),
-    )
-    .unwrap()
-}
 
 fn angles(trial: &Trial, joint: &str) -> Vec<[f64; 3]> {
     angles_on(&Model::infant13(), trial, joint)
@@ -238,22 +223,6 @@ fn elbow_mueller_recovers_both_axes_and_the_flexion() {
     assert!(raw[0] > 10.0, "raw flexion error {} deg", raw[0]);
 }
 
-/// RMS over samples of the angle between `joint`'s rotation in `trial` and
-/// in the truth, degrees: free of any Euler convention.
-fn geodesic_error_deg(model: &Model, joint: &str, trial: &Trial, sim: &Simulated) -> f64 {
-    let j = model.joint(joint).unwrap();
-    let rot = |t: &Trial| -> Vec<Quat> {
-        let p = &t.imu(&j.proximal).unwrap().orientation;
-        let d = &t.imu(&j.distal).unwrap().orientation;
-        p.iter().zip(d).map(|(p, d)| p.inverse() * d).collect()
-    };
-    let (got, want) = (rot(trial), rot(&sim.truth.segments));
-    let sum: f64 = (got.iter().zip(&want))
-        .map(|(g, w)| angle_between_deg(g, w).powi(2))
-        .sum();
-    (sum / got.len() as f64).sqrt()
-}
-
 #[test]
 fn elbow_mueller_in_standing_frames_recovers_both_axes_and_the_flexion() {
     // The standing models' segment frames hold the elbow's segment X angle:
@@ -268,8 +237,8 @@ fn elbow_mueller_in_standing_frames_recovers_both_axes_and_the_flexion() {
         let (ea, eb, mueller, raw) = elbow_case_on(&model, &cfg);
         let sim = simulate_with(&cfg, &model).unwrap();
         let corrected = run_on(&model, &sim.trial, Variant::Mueller).corrected;
-        let geo = geodesic_error_deg(&model, "l_elbow", &corrected, &sim);
-        let geo_raw = geodesic_error_deg(&model, "l_elbow", &sim.trial, &sim);
+        let geo = geodesic_error_deg(&model, "l_elbow", &corrected, &sim.truth.segments);
+        let geo_raw = geodesic_error_deg(&model, "l_elbow", &sim.trial, &sim.truth.segments);
         eprintln!(
             "{name}: axis errors {ea:.2} / {eb:.2} deg, flexion RMS {:.2} (raw {:.2}), geodesic RMS {geo:.2} (raw {geo_raw:.2})",
             mueller[0], raw[0]

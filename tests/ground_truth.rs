@@ -5,25 +5,15 @@
 //! of excursion and 2 deg of flexion range are the acceptance figures. The
 //! full-body figures compare variants on the same data, so noise cancels out.
 
-use acm_workbench::acm::{Correction, RunControl, Variant};
-use acm_workbench::correct::correct_trial;
-use acm_workbench::limits::{LimitTable, Settings};
+mod common;
+
+use acm_workbench::acm::{Correction, Variant};
+use acm_workbench::limits::LimitTable;
 use acm_workbench::metrics::{excursion_figures, joint_angles, truth_figures};
 use acm_workbench::model::Model;
 use acm_workbench::simulate::{preset, simulate, KneeAxis, KneeImu, SimConfig, Simulated};
 use acm_workbench::trial::Trial;
-
-fn run(trial: &Trial, variant: Variant) -> Correction {
-    correct_trial(
-        trial,
-        &Model::infant13(),
-        &LimitTable::default_table(),
-        &Settings::default(),
-        variant,
-        &RunControl::default(),
-    )
-    .unwrap()
-}
+use common::engine::{median, run};
 
 fn knee_angles(trial: &Trial) -> Vec<[f64; 3]> {
     let model = Model::infant13();
@@ -169,16 +159,6 @@ fn full_body_rows() -> Vec<JointRow> {
             }
         })
         .collect()
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 #[test]

@@ -13,24 +13,14 @@
 //! `full_body_drift` trial and on a second body. Both variants of a pair see
 //! the same data, so noise cancels out of the comparison.
 
-use acm_workbench::acm::{Correction, RunControl, Variant};
-use acm_workbench::correct::correct_trial;
-use acm_workbench::limits::{LimitTable, Settings};
+mod common;
+
+use acm_workbench::acm::{Correction, Variant};
+use acm_workbench::limits::Settings;
 use acm_workbench::metrics::{joint_angles, truth_figures};
 use acm_workbench::model::Model;
 use acm_workbench::simulate::{preset, simulate, HeadingDrift, SensorSlip, SimConfig, Simulated};
-
-fn run(sim: &Simulated, variant: Variant) -> Correction {
-    correct_trial(
-        &sim.trial,
-        &Model::infant13(),
-        &LimitTable::default_table(),
-        &Settings::default(),
-        variant,
-        &RunControl::default(),
-    )
-    .unwrap()
-}
+use common::engine::{median, run};
 
 /// RMS error of a joint's three angles against truth, degrees (all axes).
 fn rms(sim: &Simulated, c: &Correction, joint: &str) -> f64 {
@@ -43,24 +33,14 @@ fn rms(sim: &Simulated, c: &Correction, joint: &str) -> f64 {
     (f.rms_error_deg.iter().map(|e| e * e).sum::<f64>() / 3.0).sqrt()
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// Per joint: (name, touches a disturbed IMU, RMS with the source's model, RMS
 /// with the heading model).
 type Rows = Vec<(String, bool, f64, f64)>;
 
 /// Compares a pair of variants per joint; returns the rows and the second run.
 fn compare(sim: &Simulated, disturbed: &[&str], pair: [Variant; 2]) -> (Rows, Correction) {
-    let a = run(sim, pair[0]);
-    let b = run(sim, pair[1]);
+    let a = run(&sim.trial, pair[0]);
+    let b = run(&sim.trial, pair[1]);
     let rows: Rows = Model::infant13()
         .joints
         .iter()

@@ -10,49 +10,26 @@
 
 mod common;
 
-use acm_workbench::acm::{Correction, RunControl, Variant};
+use acm_workbench::acm::{Correction, Variant};
 use acm_workbench::baselines::mueller::angle_between_axes_deg;
-use acm_workbench::correct::correct_trial;
-use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::Model;
-use acm_workbench::rotation::{angle_between_deg, Quat};
+use acm_workbench::rotation::Quat;
 use acm_workbench::simulate::{simulate, KneeAxis, KneeImu, SimConfig, Simulated};
 use acm_workbench::trial::Trial;
+use common::engine::{geodesic_error_deg, run};
 use nalgebra::Vector3;
 
 const ANGLES_DEG: [f64; 6] = [5.0, 10.0, 15.0, 20.0, 25.0, 30.0];
 
-fn run(trial: &Trial, variant: Variant) -> Correction {
-    correct_trial(
-        trial,
-        &Model::infant13(),
-        &LimitTable::default_table(),
-        &Settings::default(),
-        variant,
-        &RunControl::default(),
-    )
-    .unwrap()
+/// The knee's geodesic error against the truth, degrees.
+fn knee_error_deg(trial: &Trial, sim: &Simulated) -> f64 {
+    geodesic_error_deg(&Model::infant13(), "l_knee", trial, &sim.truth.segments)
 }
 
 fn knee_sim(imu: KneeImu, axis: KneeAxis, angle: f64, noise_deg: f64) -> Simulated {
     let mut cfg = SimConfig::knee(imu, axis, angle);
     cfg.noise_deg = noise_deg;
     simulate(&cfg).unwrap()
-}
-
-/// RMS over samples of the angle between the knee rotation of `trial` and
-/// the true one, degrees.
-fn knee_error_deg(trial: &Trial, sim: &Simulated) -> f64 {
-    let rot = |t: &Trial| -> Vec<Quat> {
-        let p = &t.imu("l_thigh").unwrap().orientation;
-        let d = &t.imu("l_calf").unwrap().orientation;
-        p.iter().zip(d).map(|(p, d)| p.inverse() * d).collect()
-    };
-    let (got, want) = (rot(trial), rot(&sim.truth.segments));
-    let sum: f64 = (got.iter().zip(&want))
-        .map(|(g, w)| angle_between_deg(g, w).powi(2))
-        .sum();
-    (sum / got.len() as f64).sqrt()
 }
 
 /// The normalised sum of sign-aligned quaternions.

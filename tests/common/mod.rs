@@ -1,6 +1,8 @@
 //! What the command-line integration tests share: running `acmw`.
 #![allow(dead_code)] // each test file uses what it needs
 
+pub mod engine;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
