@@ -328,7 +328,10 @@ fn a_save_waits_for_the_final_correction_and_records_the_file_hash() {
     // Final: `w` saves the variant of the compare column.
     let v = Variant::ALL[app.compare_col];
     let fx = act(&mut app, Action::Save);
-    assert!(matches!(fx.as_slice(), [Effect::SaveVariant { .. }]), "{fx:?}");
+    assert!(
+        matches!(fx.as_slice(), [Effect::SaveVariant { .. }]),
+        "{fx:?}"
+    );
     SyncRunner::run(&mut app, fx);
     let out = dir.join(format!("corrected/live.{v}.csv"));
     assert!(out.is_file(), "{:?}", app.message);
