@@ -139,8 +139,8 @@ impl Sink {
 
 /// What is followed: one CSV, or a folder of Xsens exports.
 enum Reading {
-    Csv(Tail),
-    Exports(ExportsTail),
+    Csv(Box<Tail>),
+    Exports(Box<ExportsTail>),
 }
 
 /// What one look found.
@@ -290,9 +290,9 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         );
     }
     let mut reading = if input.is_dir() {
-        Reading::Exports(ExportsTail::new(input, &config.model))
+        Reading::Exports(Box::new(ExportsTail::new(input, &config.model)))
     } else {
-        Reading::Csv(Tail::new(input))
+        Reading::Csv(Box::new(Tail::new(input)))
     };
     let mut follower = Follower::new(&name, config);
     let mut sink = Sink::open(args.output.as_deref())?;
