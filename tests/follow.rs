@@ -330,3 +330,254 @@ fn a_termination_signal_ends_following_with_the_final_correction() {
     let (offline, _) = correct(dir.path(), &input);
     assert!(std::fs::read(dir.path().join("final.csv")).unwrap() == offline);
 }
+
+/// The first raw packet counter of the exports: the recording crosses the
+/// 16-bit wrap a few seconds in.
+const FIRST_PACKET: u64 = 65_300;
+
+/// `trial` as a folder of MT Manager exports (one per IMU, 50 Hz, the
+/// mapping XML beside them naming each sensor's IMU, base first): the
+/// sensors start up to two packets before the trial's first and end up to
+/// one after its last (those packets hold the nearest sample), the third
+/// misses three packets (a gap every sensor's trial then has), and the
+/// counters wrap from 65535 to 0. Returns the export paths and texts; only
+/// the mapping is written.
+fn xsens_exports(folder: &Path, trial: &Trial) -> Vec<(std::path::PathBuf, String)> {
+    use std::fmt::Write as _;
+    std::fs::create_dir_all(folder).unwrap();
+    let n = trial.len() as u64;
+    let serial = |k: usize| format!("00B4{k:04X}");
+    let mut xml = String::from(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n<OpenSimDocument Version=\"40000\">\n\t<XsensDataReaderSettings>\n\t\t<trial_prefix>MT_LIVE-000</trial_prefix>\n\t\t<ExperimentalSensors>\n",
+    );
+    for (k, s) in trial.imus.iter().enumerate() {
+        let _ = write!(
+            xml,
+            "\t\t\t<ExperimentalSensor name=\"_{}\">\n\t\t\t\t<name_in_model>{}</name_in_model>\n\t\t\t</ExperimentalSensor>\n",
+            serial(k),
+            s.name
+        );
+    }
+    xml.push_str("\t\t</ExperimentalSensors>\n\t</XsensDataReaderSettings>\n</OpenSimDocument>\n");
+    std::fs::write(folder.join("myIMUMappings.xml"), xml).unwrap();
+    let mut out = Vec::new();
+    for (k, s) in trial.imus.iter().enumerate() {
+        let mut text = String::from(
+            "// Start Time: Unknown\n// Update Rate: 50.0Hz\n// Filter Profile: human (46.1)\n",
+        );
+        text.push_str("PacketCounter\tSampleTimeFine\tQuat_q0\tQuat_q1\tQuat_q2\tQuat_q3");
+        if s.gyro.is_some() {
+            text.push_str("\tGyr_X\tGyr_Y\tGyr_Z");
+        }
+        text.push('\n');
+        let first = FIRST_PACKET - (k as u64 % 3);
+        let last = FIRST_PACKET + n - 1 + (k as u64 % 2);
+        for c in first..=last {
+            if k == 2 && (FIRST_PACKET + 400..FIRST_PACKET + 403).contains(&c) {
+                continue;
+            }
+            let i = (c.clamp(FIRST_PACKET, FIRST_PACKET + n - 1) - FIRST_PACKET) as usize;
+            let q = s.orientation[i];
+            let _ = write!(
+                text,
+                "{:05}\t{}\t{}\t{}\t{}\t{}",
+                c % 65_536,
+                c * 200,
+                q.w,
+                q.i,
+                q.j,
+                q.k
+            );
+            if let Some(g) = &s.gyro {
+                let _ = write!(text, "\t{}\t{}\t{}", g[i].x, g[i].y, g[i].z);
+            }
+            text.push('\n');
+        }
+        out.push((folder.join(format!("MT_LIVE-000_{}.txt", serial(k))), text));
+    }
+    out
+}
+
+/// Appends `parts[k]` to `paths[k]`, all of them at once as MT Manager
+/// writes them: each step a random export gets a random fragment of
+/// 1..=3000 bytes (cut anywhere), flushed, over about `seconds`.
+fn write_exports_in_fragments(
+    paths: &[std::path::PathBuf],
+    parts: &[&[u8]],
+    seconds: f64,
+    seed: u64,
+) {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut files: Vec<std::fs::File> = paths
+        .iter()
+        .map(|p| {
+            std::fs::OpenOptions::new()
+                .append(true)
+                .create(true)
+                .open(p)
+                .unwrap()
+        })
+        .collect();
+    let total: usize = parts.iter().map(|p| p.len()).sum();
+    let per_byte = seconds / total.max(1) as f64;
+    let mut pos = vec![0usize; parts.len()];
+    loop {
+        let open: Vec<usize> = (0..parts.len())
+            .filter(|&k| pos[k] < parts[k].len())
+            .collect();
+        if open.is_empty() {
+            break;
+        }
+        let k = open[rng.random_range(0..open.len())];
+        let n = rng.random_range(1..=3000).min(parts[k].len() - pos[k]);
+        files[k].write_all(&parts[k][pos[k]..pos[k] + n]).unwrap();
+        files[k].flush().unwrap();
+        pos[k] += n;
+        std::thread::sleep(Duration::from_secs_f64(n as f64 * per_byte));
+    }
+}
+
+/// `acmw follow FOLDER` with the final correction in `final.sto`.
+fn follow_exports(dir: &Path, folder: &Path) -> Child {
+    acmw()
+        .current_dir(dir)
+        .arg("follow")
+        .arg(folder)
+        .args([
+            "-o",
+            "stream.csv",
+            "--corrected",
+            "final.sto",
+            "--sidecar",
+            "final.json",
+        ])
+        .args([
+            "--idle-exit",
+            "2",
+            "--window",
+            "30",
+            "--hop",
+            "15",
+            "--warmup",
+            "5",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// `acmw correct FOLDER` into `offline.sto`, with the follower's settings.
+fn correct_exports(dir: &Path, folder: &Path) -> (Vec<u8>, serde_json::Value) {
+    let out = acmw()
+        .current_dir(dir)
+        .arg("correct")
+        .arg(folder)
+        .args(["-o", "offline.sto", "--sidecar", "offline.json", "-q"])
+        .args(["--window", "30", "--hop", "15"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    (
+        std::fs::read(dir.join("offline.sto")).unwrap(),
+        sidecar(&dir.join("offline.json")),
+    )
+}
+
+#[test]
+fn an_xsens_export_folder_is_followed_and_its_final_correction_equals_correct() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("exports");
+    let trial = drifting(120.0, 11);
+    let exports = xsens_exports(&folder, &trial);
+    let paths: Vec<_> = exports.iter().map(|(p, _)| p.clone()).collect();
+    let parts: Vec<&[u8]> = exports.iter().map(|(_, t)| t.as_bytes()).collect();
+    // The follower starts before MT Manager has created the exports.
+    let child = follow_exports(dir.path(), &folder);
+    std::thread::sleep(Duration::from_millis(300));
+    // 120 s of 13 sensors written in about 8 s (x15), from another thread.
+    std::thread::scope(|s| {
+        s.spawn(|| write_exports_in_fragments(&paths, &parts, 8.0, 12));
+    });
+    let (_, stderr) = finish(child);
+    assert!(stderr.contains("solved 0-5.0 s"), "{stderr}");
+    assert!(!stderr.contains("starting over"), "{stderr}");
+    let (offline, offline_sidecar) = correct_exports(dir.path(), &folder);
+    let fin = std::fs::read(dir.path().join("final.sto")).unwrap();
+    assert!(
+        fin == offline,
+        "the final correction differs from acmw correct"
+    );
+    assert_eq!(sidecar(&dir.path().join("final.json")), offline_sidecar);
+    // The stream holds every aligned row once (the gap's packets left out
+    // of every sensor), the base IMU as the whole-folder reader reads it.
+    let written = read_trial(&folder, &model()).unwrap();
+    assert_eq!(written.len(), trial.len() - 3);
+    check_stream(
+        &dir.path().join("stream.csv"),
+        &written,
+        TrialFormat::QuatCsv,
+    );
+    let live = read_trial(&dir.path().join("stream.csv"), &model()).unwrap();
+    let calf = (live.imu("l_calf").unwrap(), written.imu("l_calf").unwrap());
+    let last = live.len() - 1;
+    assert!(
+        acm_workbench::rotation::angle_between_deg(
+            &calf.0.orientation[last],
+            &calf.1.orientation[last]
+        ) > 1.0,
+        "the last live row was not corrected"
+    );
+}
+
+#[test]
+fn a_truncated_export_starts_the_folder_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("exports");
+    let trial = drifting(40.0, 13);
+    let exports = xsens_exports(&folder, &trial);
+    let paths: Vec<_> = exports.iter().map(|(p, _)| p.clone()).collect();
+    let half: Vec<&[u8]> = exports
+        .iter()
+        .map(|(_, t)| &t.as_bytes()[..t.len() / 2])
+        .collect();
+    let child = follow_exports(dir.path(), &folder);
+    write_exports_in_fragments(&paths, &half, 1.5, 14);
+    std::thread::sleep(Duration::from_millis(800));
+    // MT Manager starts one export over: truncated, then written again.
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&paths[4])
+        .unwrap()
+        .set_len(0)
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    let rest: Vec<&[u8]> = exports
+        .iter()
+        .enumerate()
+        .map(|(k, (_, t))| {
+            let b = t.as_bytes();
+            if k == 4 {
+                b
+            } else {
+                &b[b.len() / 2..]
+            }
+        })
+        .collect();
+    write_exports_in_fragments(&paths, &rest, 1.5, 15);
+    let (_, stderr) = finish(child);
+    assert!(
+        stderr.contains("export MT_LIVE-000_00B40004.txt was truncated")
+            && stderr.contains("starting over"),
+        "{stderr}"
+    );
+    let (offline, _) = correct_exports(dir.path(), &folder);
+    assert!(std::fs::read(dir.path().join("final.sto")).unwrap() == offline);
+    let written = read_trial(&folder, &model()).unwrap();
+    check_stream(
+        &dir.path().join("stream.csv"),
+        &written,
+        TrialFormat::QuatCsv,
+    );
+}

@@ -5,9 +5,12 @@
 use super::common::{load_context, load_prepared, variant_parser, EngineArgs};
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation, Source};
-use acm_workbench::follow::{Extrapolation, Follower, FollowerConfig, Tail, TailEvent};
-use acm_workbench::trial::format::is_followable_name;
-use acm_workbench::trial::{detect_model, trial_to_string, TrialFormat};
+use acm_workbench::follow::{
+    exports_ready, ExportsEvent, ExportsTail, Extrapolation, Follower, FollowerConfig, Tail,
+    TailEvent,
+};
+use acm_workbench::trial::format::{is_followable, is_stream_format};
+use acm_workbench::trial::{detect_model, trial_to_string, Trial, TrialFormat};
 use anyhow::Context as _;
 use clap::Args;
 use std::io::Write;
@@ -20,7 +23,9 @@ use std::time::{Duration, Instant};
 pub struct FollowArgs {
     /// The trial another program is appending to: a canonical CSV
     /// (`time,<imu>_qw,_qx,_qy,_qz,...`) or an Euler CSV
-    /// (`time,<imu>_roll,_pitch,_yaw,...`), not compressed. It need not exist yet.
+    /// (`time,<imu>_roll,_pitch,_yaw,...`), not compressed (it need not
+    /// exist yet), or a folder of Xsens MT Manager exports, one per sensor,
+    /// that MT Manager appends to (rows aligned on the packet counter).
     pub input: PathBuf,
     /// Write the live corrected rows to this file (created afresh, appended
     /// and flushed per batch) instead of standard output.
@@ -36,7 +41,9 @@ pub struct FollowArgs {
     /// Correction variant.
     #[arg(long, value_parser = variant_parser(), default_value = "drift-centroid")]
     pub variant: Variant,
-    /// Output format of the live rows and the final trial [default: the input's].
+    /// Output format of the live rows and the final trial [default: the
+    /// input's; for Xsens exports, quat-csv live and the final trial as
+    /// `acmw correct` writes it].
     #[arg(long, value_parser = super::common::named_parser::<TrialFormat>())]
     pub format: Option<TrialFormat>,
     /// How rows past the last solved window are corrected.
@@ -130,6 +137,66 @@ impl Sink {
     }
 }
 
+/// What is followed: one CSV, or a folder of Xsens exports.
+enum Reading {
+    Csv(Box<Tail>),
+    Exports(Box<ExportsTail>),
+}
+
+/// What one look found.
+enum Got {
+    Nothing,
+    Restarted(String),
+    Lines { text: String, first_line: u64 },
+    Samples(Trial),
+}
+
+impl Reading {
+    fn poll(&mut self) -> anyhow::Result<Got> {
+        Ok(match self {
+            Reading::Csv(t) => match t.poll()? {
+                TailEvent::Nothing => Got::Nothing,
+                TailEvent::Restarted { reason } => Got::Restarted(reason),
+                TailEvent::Lines { text, first_line } => Got::Lines { text, first_line },
+            },
+            Reading::Exports(x) => match x.poll()? {
+                ExportsEvent::Nothing => Got::Nothing,
+                ExportsEvent::Restarted { reason } => Got::Restarted(reason),
+                ExportsEvent::Samples(t) => Got::Samples(t),
+            },
+        })
+    }
+
+    /// Bytes read so far (over every export).
+    fn offset(&self) -> u64 {
+        match self {
+            Reading::Csv(t) => t.offset(),
+            Reading::Exports(x) => x.offset(),
+        }
+    }
+
+    /// Whether every byte on disk was read, with no unfinished line.
+    fn read_whole(&self, input: &Path) -> bool {
+        match self {
+            Reading::Csv(t) => {
+                let len = std::fs::metadata(input).map(|m| m.len()).ok();
+                !t.has_partial_line() && len == Some(t.offset())
+            }
+            Reading::Exports(x) => x.read_whole(),
+        }
+    }
+}
+
+/// Adds what a look found to the follower: the indices of the new samples.
+fn push(follower: &mut Follower, got: Got) -> anyhow::Result<std::ops::Range<usize>> {
+    let n = follower.trial().map_or(0, Trial::len);
+    Ok(match got {
+        Got::Lines { text, first_line } => follower.push(&text, first_line)?,
+        Got::Samples(batch) => follower.push_samples(batch)?,
+        Got::Nothing | Got::Restarted(_) => n..n,
+    })
+}
+
 /// Why following ended.
 #[derive(Debug, PartialEq)]
 enum End {
@@ -148,7 +215,11 @@ fn wait_for_header(
 ) -> anyhow::Result<bool> {
     let start = Instant::now();
     loop {
-        if let Ok(text) = acm_workbench::input::read_bytes(path) {
+        if path.is_dir() {
+            if exports_ready(path) {
+                return Ok(true);
+            }
+        } else if let Ok(text) = acm_workbench::input::read_bytes(path) {
             let text = String::from_utf8_lossy(&text);
             let complete = text.split_inclusive('\n').any(|l| {
                 let t = l.trim_start_matches('\u{feff}').trim();
@@ -169,12 +240,12 @@ fn wait_for_header(
 pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     let input = &args.input;
     let name = input.display().to_string();
-    if !is_followable_name(input) {
+    if !is_followable(input) {
         anyhow::bail!(
-            "{name}: acmw follow reads a growing canonical or Euler CSV (a name ending in .csv, not compressed); `acmw correct` reads the other formats once they are complete"
+            "{name}: acmw follow reads a growing canonical or Euler CSV (a name ending in .csv, not compressed) or a folder of Xsens exports; `acmw correct` reads the other formats once they are complete"
         );
     }
-    if args.format.is_some_and(|f| !f.row().followable) {
+    if args.format.is_some_and(|f| !is_stream_format(f)) {
         anyhow::bail!("--format: acmw follow writes quat-csv or euler-csv");
     }
     let stop = Arc::new(AtomicBool::new(false));
@@ -184,6 +255,9 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     let poll = Duration::from_secs_f64(args.poll.max(0.001));
     let idle = args.idle_exit.map(Duration::from_secs_f64);
     if !wait_for_header(input, poll, &stop, idle)? {
+        if input.is_dir() {
+            anyhow::bail!("{name}: no Xsens exports with complete header lines arrived: expected MT Manager exports being written into this folder");
+        }
         anyhow::bail!("{name}: no header line arrived: expected a trial being written");
     }
     let ctx = load_context(&args.engine, || Ok(detect_model(input)))?;
@@ -215,8 +289,12 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
             acm_workbench::names::Named::name(args.extrapolate)
         );
     }
+    let mut reading = if input.is_dir() {
+        Reading::Exports(Box::new(ExportsTail::new(input, &config.model)))
+    } else {
+        Reading::Csv(Box::new(Tail::new(input)))
+    };
     let mut follower = Follower::new(&name, config);
-    let mut tail = Tail::new(input);
     let mut sink = Sink::open(args.output.as_deref())?;
     let (wake_tx, wake_rx) = crossbeam_channel::unbounded::<()>();
     let _watcher = watch(input, wake_tx, args.quiet);
@@ -226,17 +304,17 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         if stop.load(Ordering::Relaxed) {
             break End::Interrupted;
         }
-        let before = tail.offset();
-        match tail.poll()? {
-            TailEvent::Nothing => {}
-            TailEvent::Restarted { reason } => {
+        let before = reading.offset();
+        match reading.poll()? {
+            Got::Nothing => {}
+            Got::Restarted(reason) => {
                 eprintln!("{name} {reason}: starting over");
                 follower.restart();
                 sink.restart()?;
                 format = args.format;
             }
-            TailEvent::Lines { text, first_line } => {
-                let range = follower.push(&text, first_line)?;
+            got => {
+                let range = push(&mut follower, got)?;
                 if !range.is_empty() {
                     let fmt = *format
                         .get_or_insert_with(|| follower.format().unwrap_or(TrialFormat::QuatCsv));
@@ -246,7 +324,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
                 }
             }
         }
-        if tail.offset() != before {
+        if reading.offset() != before {
             last_growth = Instant::now();
         }
         for solved in follower.poll_solved() {
@@ -277,8 +355,8 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     follower.stop();
     // What the writer added since the last look, up to the end.
     if end != End::Until {
-        while let TailEvent::Lines { text, first_line } = tail.poll()? {
-            let range = follower.push(&text, first_line)?;
+        while let got @ (Got::Lines { .. } | Got::Samples(_)) = reading.poll()? {
+            let range = push(&mut follower, got)?;
             if let (false, Some(batch)) = (range.is_empty(), follower.corrected(range.clone())) {
                 let fmt = format.unwrap_or(TrialFormat::QuatCsv);
                 sink.write(&trial_to_string(&batch, fmt))?;
@@ -293,10 +371,10 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         };
         eprintln!("{name}: {why}; writing the final correction");
     }
-    final_correction(&args, &ctx, &follower, &tail, end == End::Until)
+    final_correction(&args, &ctx, &follower, &reading, end == End::Until)
 }
 
-/// Watches the input's folder for changes (each wakes the loop); `None` when
+/// Watches the input's folder (or the folder of exports) for changes (each wakes the loop); `None` when
 /// notifications are not available (the poll interval alone then paces it).
 fn watch(
     input: &Path,
@@ -304,7 +382,9 @@ fn watch(
     quiet: bool,
 ) -> Option<notify::RecommendedWatcher> {
     use notify::Watcher;
+    // A folder of exports is watched itself; a file, through its folder.
     let dir = match input.parent() {
+        _ if input.is_dir() => input.to_path_buf(),
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
@@ -333,12 +413,11 @@ fn final_correction(
     args: &FollowArgs,
     ctx: &super::common::Context,
     follower: &Follower,
-    tail: &Tail,
+    reading: &Reading,
     cut: bool,
 ) -> anyhow::Result<i32> {
     let input = &args.input;
-    let len = std::fs::metadata(input).map(|m| m.len()).ok();
-    let whole = !cut && !tail.has_partial_line() && len == Some(tail.offset());
+    let whole = !cut && reading.read_whole(input);
     let (source, prepared) = if whole {
         let file = pipeline::read(input)?;
         load_prepared(ctx, &file, &Preparation::default(), false, args.quiet)?

@@ -212,23 +212,54 @@ impl Follower {
         if self.reached_until || rest.trim().is_empty() {
             return Ok(before..before);
         }
-        let mut batch =
-            read_rows_from_str(&self.header, rest, line, &self.origin, &self.config.model)?;
+        let batch = read_rows_from_str(&self.header, rest, line, &self.origin, &self.config.model)?;
         // The first data row's line, for an error about its time.
         let row_line = line
             + rest
                 .split('\n')
                 .position(|l| !l.trim().is_empty())
                 .unwrap_or(0) as u64;
+        self.add(batch, row_line)
+    }
+
+    /// Adds samples read by another reader (the aligned rows of Xsens
+    /// exports, [`crate::trial::xsens_trial::GrowingExports`]): the same
+    /// IMUs in the same order at each call, later times. Returns the
+    /// indices of the new samples.
+    pub fn push_samples(&mut self, batch: Trial) -> Result<Range<usize>, TrialError> {
+        let before = self.trial.as_ref().map_or(0, Trial::len);
+        if self.reached_until || batch.is_empty() {
+            return Ok(before..before);
+        }
+        if let Some(trial) = &self.trial {
+            let names = |t: &Trial| t.imus.iter().map(|s| s.name.clone()).collect::<Vec<_>>();
+            if names(trial) != names(&batch) {
+                return Err(TrialError::file(
+                    &self.origin,
+                    format!(
+                        "the IMUs changed from {} to {}; expected the same IMUs in every batch",
+                        names(trial).join(", "),
+                        names(&batch).join(", ")
+                    ),
+                ));
+            }
+        }
+        self.add(batch, 0)
+    }
+
+    /// Adds a batch of rows (the first at `row_line` of the file, 0 when
+    /// not from one line of it).
+    fn add(&mut self, mut batch: Trial, row_line: u64) -> Result<Range<usize>, TrialError> {
+        let before = self.trial.as_ref().map_or(0, Trial::len);
         if let Some(prev) = self.trial.as_ref().and_then(|t| t.time_s.last().copied()) {
             let t = batch.time_s[0];
             if t <= prev {
-                return Err(TrialError::at(
-                    &self.origin,
-                    row_line,
-                    1,
-                    format!("time {t} does not follow the previous time {prev}; expected times to strictly increase"),
-                ));
+                let message = format!("time {t} does not follow the previous time {prev}; expected times to strictly increase");
+                return Err(if row_line == 0 {
+                    TrialError::file(&self.origin, message)
+                } else {
+                    TrialError::at(&self.origin, row_line, 1, message)
+                });
             }
         }
         let t0 = self.trial.as_ref().map_or(batch.time_s[0], |t| t.time_s[0]);

@@ -4,6 +4,9 @@
 //! * [`tail`] reads what was appended to a canonical or Euler CSV since the
 //!   last look, complete lines only, and notices when the file was
 //!   truncated or replaced;
+//! * [`exports`] does the same for a folder of Xsens exports, one [`Tail`]
+//!   per export, and hands out the rows every sensor has written, aligned
+//!   on the packet counter;
 //! * [`schedule`] says when the growing trial is solved again: while the
 //!   first drift window fills, every few seconds of trial time; then each
 //!   time a window `[k * hop, k * hop + window)` is complete;
@@ -17,11 +20,13 @@
 //! The final, offline-quality correction is the pipeline's own, run on the
 //! whole trial once it stops growing.
 
+pub mod exports;
 pub mod extrapolate;
 pub mod live;
 pub mod schedule;
 pub mod tail;
 
+pub use exports::{exports_ready, ExportsEvent, ExportsTail};
 pub use extrapolate::{Extrapolation, ImuExtrapolation, Solution};
 pub use live::{Follower, FollowerConfig, Solved};
 pub use schedule::Schedule;

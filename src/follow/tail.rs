@@ -1,5 +1,6 @@
 //! Reading a file another program is appending to: complete lines only.
 
+use sha2::{Digest, Sha256};
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
@@ -37,6 +38,9 @@ pub struct Tail {
     head: Vec<u8>,
     /// Device and inode of the file read (unix), to notice a replacement.
     identity: Option<(u64, u64)>,
+    /// SHA-256 of the `offset` bytes read so far, in order, updated as they
+    /// are read (the file is never read twice for it).
+    hash: Sha256,
 }
 
 impl Tail {
@@ -49,7 +53,21 @@ impl Tail {
             lines: 0,
             head: Vec::new(),
             identity: None,
+            hash: Sha256::new(),
         }
+    }
+
+    /// SHA-256 (hex) of the bytes read so far (complete lines and a partial
+    /// one): once the writer has stopped and everything was read, the hash
+    /// of the whole file, as [`crate::input::sha256_hex`] of its bytes and a
+    /// sidecar's input hash record it.
+    pub fn sha256_hex(&self) -> String {
+        self.hash
+            .clone()
+            .finalize()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
     }
 
     /// Bytes read so far, complete lines and a partial one.
@@ -127,6 +145,7 @@ impl Tail {
             self.head.extend_from_slice(&data[..want.min(data.len())]);
         }
         self.offset += data.len() as u64;
+        self.hash.update(&data);
         self.pending.extend_from_slice(&data);
         let Some(last) = self.pending.iter().rposition(|&b| b == b'\n') else {
             return Ok(TailEvent::Nothing);
@@ -191,6 +210,10 @@ mod tests {
         f.write_all(b"2,1\r\n").unwrap();
         assert_eq!(lines(tail.poll().unwrap()), ("0.02,1\r\n".into(), 3));
         assert_eq!(tail.poll().unwrap(), TailEvent::Nothing);
+        // The running hash is the whole file's, read in four looks.
+        let whole = std::fs::read(&path).unwrap();
+        assert_eq!(tail.offset(), whole.len() as u64);
+        assert_eq!(tail.sha256_hex(), crate::input::sha256_hex(&whole));
         // Truncated below what was read.
         f.set_len(5).unwrap();
         let TailEvent::Restarted { reason } = tail.poll().unwrap() else {
@@ -200,6 +223,11 @@ mod tests {
         drop(f);
         std::fs::write(&path, "time,b_qw\n0,1\n").unwrap();
         assert_eq!(lines(tail.poll().unwrap()).1, 1);
+        // Started over: the hash covers the new bytes only.
+        assert_eq!(
+            tail.sha256_hex(),
+            crate::input::sha256_hex(b"time,b_qw\n0,1\n")
+        );
         // Rewritten in place, same length or longer.
         std::fs::write(&path, "time,c_qw\n0,1\n1,1\n").unwrap();
         let TailEvent::Restarted { reason } = tail.poll().unwrap() else {

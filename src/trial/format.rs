@@ -43,8 +43,9 @@ pub struct FormatRow {
     pub writable: bool,
     /// The format a corrected trial of this one is written in by default.
     pub output: TrialFormat,
-    /// Whether a growing file of this format can be followed (`acmw follow`):
-    /// uncompressed, one complete sample per appended line.
+    /// Whether a growing trial of this format can be followed (`acmw
+    /// follow`): uncompressed, one complete sample per appended line (for
+    /// Xsens exports, a folder of them, one line per packet in each).
     pub followable: bool,
 }
 
@@ -92,7 +93,7 @@ pub const FORMATS: [FormatRow; 4] = [
         reader: Reader::Exports,
         writable: false,
         output: TrialFormat::Sto,
-        followable: false,
+        followable: true,
     },
 ];
 
@@ -193,10 +194,29 @@ pub fn could_name_trial(path: &Path) -> bool {
     super::is_trial_file(path) || names_exports(path)
 }
 
-/// True when `path` can be followed while it grows (`acmw follow`): an
-/// uncompressed CSV, the layout of the [`FormatRow::followable`] formats.
+/// True when `path` names a file that can be followed while it grows: an
+/// uncompressed CSV, the file layout of the [`FormatRow::followable`]
+/// formats (what the workbench follows).
 pub fn is_followable_name(path: &Path) -> bool {
     !path.is_dir() && kind_of_name(path) == Some((Kind::Csv, false))
+}
+
+/// True when `path` can be followed while it grows (`acmw follow`): a file
+/// [`is_followable_name`] accepts, or a folder, read as the Xsens exports
+/// (the [`Layout::Exports`] followable format) that are, or will be,
+/// written into it.
+pub fn is_followable(path: &Path) -> bool {
+    let exports = FORMATS
+        .iter()
+        .any(|r| r.followable && r.layout == Layout::Exports);
+    is_followable_name(path) || (exports && path.is_dir())
+}
+
+/// True when trials in `format` can be written as a growing stream (`acmw
+/// follow`'s live rows): followable and writable.
+pub fn is_stream_format(format: TrialFormat) -> bool {
+    let row = format.row();
+    row.followable && row.writable
 }
 
 #[cfg(test)]
@@ -236,5 +256,11 @@ mod tests {
         assert!(is_followable_name(Path::new("live.csv")));
         assert!(!is_followable_name(Path::new("live.csv.gz")));
         assert!(!is_followable_name(Path::new("live.sto")));
+        let dir = std::env::temp_dir();
+        assert!(is_followable(&dir) && !is_followable_name(&dir));
+        assert!(is_followable(Path::new("live.csv")));
+        assert!(!is_followable(Path::new("m.xml")));
+        assert!(is_stream_format(TrialFormat::QuatCsv) && is_stream_format(TrialFormat::EulerCsv));
+        assert!(!is_stream_format(TrialFormat::Xsens) && !is_stream_format(TrialFormat::Sto));
     }
 }

@@ -393,66 +393,119 @@ impl Cells<'_> {
 
 /// Reads one export from its text; `origin` names the file in errors.
 pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError> {
+    let mut reader = ExportReader::new(origin);
     let mut lines = LineIter::new(text);
-    let mut rate_hz = None;
-    let mut rate_at = (1, 1);
-    let mut coordinate_system = None;
-    let (header_line, header_text) = loop {
-        let Some((n, l)) = lines.next_nonblank() else {
-            return Err(TrialError::at(
-                origin,
-                lines.line_no().max(1),
-                1,
-                "no header: expected '// ...' comment lines then a header with PacketCounter",
-            ));
+    let mut cells: Vec<&str> = Vec::new();
+    for (n, l) in lines.by_ref() {
+        reader.line(n, l, &mut cells)?;
+    }
+    reader.finish(lines.line_no())
+}
+
+/// The header of an export, once read.
+struct Header {
+    line: u64,
+    delimiter: Delimiter,
+    names: Vec<String>,
+    cols: Columns,
+}
+
+/// An export read line by line, as its lines arrive: the comments and the
+/// header, then one sample per data row. [`parse_export`] reads a whole
+/// file through it; a follower of a growing export feeds it the complete
+/// lines appended since its last look.
+pub struct ExportReader {
+    /// The samples so far (and the comments' rate and frame).
+    out: XsensExport,
+    header: Option<Header>,
+    /// `SampleTimeFine` per sample, when the column exists.
+    ticks: Vec<Option<f64>>,
+    /// The last raw counter and its line.
+    last_raw: Option<(u64, u64)>,
+    /// Wraps of the 16-bit counter so far.
+    wraps: u64,
+}
+
+impl ExportReader {
+    /// A reader of the export `origin` (named in errors) that has read nothing.
+    pub fn new(origin: &str) -> ExportReader {
+        ExportReader {
+            out: XsensExport {
+                origin: origin.to_string(),
+                rate_hz: None,
+                rate_at: (1, 1),
+                sample_time_rate_hz: None,
+                coordinate_system: None,
+                delimiter: Delimiter::Tab,
+                counters: Vec::new(),
+                lines: Vec::new(),
+                orientation: Vec::new(),
+                columns: OrientationColumns::Quaternion,
+                gyro: None,
+                renormalised: 0,
+            },
+            header: None,
+            ticks: Vec::new(),
+            last_raw: None,
+            wraps: 0,
+        }
+    }
+
+    /// Whether the header line was read (the comments before it are all in).
+    pub fn has_header(&self) -> bool {
+        self.header.is_some()
+    }
+
+    /// The export as read so far: its comments' rate and frame, the samples
+    /// of the rows read (`sample_time_rate_hz` is filled in by [`ExportReader::finish`]).
+    pub fn export(&self) -> &XsensExport {
+        &self.out
+    }
+
+    /// The rate [`ExportReader::finish`] would find from `SampleTimeFine`
+    /// on the rows read so far (`None`: no such column, or fewer than two
+    /// usable readings).
+    pub fn sample_time_rate_hz(&self) -> Option<f64> {
+        self.header.as_ref()?.cols.sample_time?;
+        rate_of_sample_time(&self.out.counters, &self.ticks)
+    }
+
+    /// Reads the complete lines `text` whose first is 1-based line
+    /// `first_line` of the file (a byte-order mark at the file's start is skipped).
+    pub fn push_lines(&mut self, text: &str, first_line: u64) -> Result<(), TrialError> {
+        let text = if first_line == 1 {
+            text.strip_prefix('\u{feff}').unwrap_or(text)
+        } else {
+            text
         };
-        match l.trim_start().strip_prefix("//") {
-            Some(c) => {
-                if let (None, Some((value, rate))) = (rate_hz, rate_of_comment(c)) {
-                    // Column (characters) of the value in the line.
-                    let offset = value.as_ptr() as usize - l.as_ptr() as usize;
-                    let column = l[..offset].chars().count() + 1;
-                    rate_at = (n, column);
-                    rate_hz = Some(rate.map_err(|m| TrialError::at(origin, n, column, m))?);
-                }
-                coordinate_system = coordinate_system.or_else(|| {
-                    comment_value(c, "coordinate system").map(|v| v.to_ascii_uppercase())
-                });
-            }
-            None => break (n, l),
+        let mut cells: Vec<&str> = Vec::new();
+        for (n, l) in LineIter::starting_at(text, first_line) {
+            self.line(n, l, &mut cells)?;
         }
-    };
-    let delimiter = Delimiter::of_header(header_text);
-    let sep = delimiter.char();
-    let header: Vec<&str> = header_text.split(sep).map(str::trim).collect();
-    let cols = columns(&header, origin, header_line)?;
-    let reader = Cells { origin, delimiter };
-    let mut out = XsensExport {
-        origin: origin.to_string(),
-        rate_hz,
-        rate_at,
-        sample_time_rate_hz: None,
-        coordinate_system,
-        delimiter,
-        counters: Vec::new(),
-        lines: Vec::new(),
-        orientation: Vec::new(),
-        columns: cols.kind,
-        gyro: cols.gyro.map(|_| Vec::new()),
-        renormalised: 0,
-    };
-    let mut ticks: Vec<Option<f64>> = Vec::new();
-    let mut last_raw: Option<(u64, u64)> = None;
-    let mut wraps = 0u64;
-    let mut cells: Vec<&str> = Vec::with_capacity(header.len());
-    for (line, text) in lines.by_ref() {
+        Ok(())
+    }
+
+    /// Reads line `n` (without its newline); `cells` is scratch space.
+    fn line<'t>(&mut self, n: u64, l: &'t str, cells: &mut Vec<&'t str>) -> Result<(), TrialError> {
+        let Some(header) = &self.header else {
+            return self.head_line(n, l);
+        };
+        let text = l;
+        let line = n;
         if text.trim().is_empty() || text.trim_start().starts_with("//") {
-            continue;
+            return Ok(());
         }
+        let origin = self.out.origin.as_str();
+        let cols = &header.cols;
+        let names = &header.names;
+        let reader = Cells {
+            origin,
+            delimiter: header.delimiter,
+        };
         cells.clear();
-        cells.extend(text.split(sep));
-        let raw = reader.counter(&cells, cols.counter, line)?;
-        if let Some((prev, prev_line)) = last_raw {
+        cells.extend(text.split(header.delimiter.char()));
+        let raw = reader.counter(cells, cols.counter, line)?;
+        if let Some((prev, prev_line)) = self.last_raw {
             if raw == prev {
                 return Err(TrialError::at(
                     origin,
@@ -463,7 +516,7 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
             }
             if raw < prev {
                 if prev - raw > COUNTER_MODULUS / 2 {
-                    wraps += 1;
+                    self.wraps += 1;
                 } else {
                     return Err(TrialError::at(
                         origin,
@@ -474,49 +527,111 @@ pub fn parse_export(text: &str, origin: &str) -> Result<XsensExport, TrialError>
                 }
             }
         }
-        last_raw = Some((raw, line));
-        let q = orientation(&reader, &cells, &cols, &header, line, &mut out.renormalised)?;
-        if let (Some(fields), Some(g)) = (cols.gyro, &mut out.gyro) {
-            let [x, y, z] = fields.map(|k| reader.number(&cells, k, line, header[k]));
-            g.push(Vector3::new(x?, y?, z?));
-        }
+        let mut renormalised = 0;
+        let q = orientation(&reader, cells, cols, names, line, &mut renormalised)?;
+        let gyro = match cols.gyro {
+            Some(fields) => {
+                let [x, y, z] = fields.map(|k| reader.number(cells, k, line, &names[k]));
+                Some(Vector3::new(x?, y?, z?))
+            }
+            None => None,
+        };
         if let Some(k) = cols.sample_time {
-            ticks.push(
+            self.ticks.push(
                 cells
                     .get(k)
                     .and_then(|c| reader.parse(c.trim().trim_matches('"'))),
             );
         }
-        out.counters.push(raw + wraps * COUNTER_MODULUS);
+        self.last_raw = Some((raw, line));
+        let out = &mut self.out;
+        out.renormalised += renormalised;
+        if let (Some(g), Some(v)) = (&mut out.gyro, gyro) {
+            g.push(v);
+        }
+        out.counters.push(raw + self.wraps * COUNTER_MODULUS);
         out.lines.push(line);
         out.orientation.push(q);
+        Ok(())
     }
-    if out.counters.is_empty() {
-        return Err(TrialError::at(
-            origin,
-            lines.line_no() + 1,
-            1,
-            format!("no samples: expected data rows after the header on line {header_line}"),
-        ));
+
+    /// A line before the header: blank, a `//` comment, or the header.
+    fn head_line(&mut self, n: u64, l: &str) -> Result<(), TrialError> {
+        if l.trim().is_empty() {
+            return Ok(());
+        }
+        let origin = self.out.origin.as_str();
+        if let Some(c) = l.trim_start().strip_prefix("//") {
+            if let (None, Some((value, rate))) = (self.out.rate_hz, rate_of_comment(c)) {
+                // Column (characters) of the value in the line.
+                let offset = value.as_ptr() as usize - l.as_ptr() as usize;
+                let column = l[..offset].chars().count() + 1;
+                self.out.rate_at = (n, column);
+                self.out.rate_hz = Some(rate.map_err(|m| TrialError::at(origin, n, column, m))?);
+            }
+            if self.out.coordinate_system.is_none() {
+                self.out.coordinate_system =
+                    comment_value(c, "coordinate system").map(|v| v.to_ascii_uppercase());
+            }
+            return Ok(());
+        }
+        let delimiter = Delimiter::of_header(l);
+        let names: Vec<&str> = l.split(delimiter.char()).map(str::trim).collect();
+        let cols = columns(&names, origin, n)?;
+        self.out.delimiter = delimiter;
+        self.out.columns = cols.kind;
+        self.out.gyro = cols.gyro.map(|_| Vec::new());
+        self.header = Some(Header {
+            line: n,
+            delimiter,
+            names: names.into_iter().map(str::to_string).collect(),
+            cols,
+        });
+        Ok(())
     }
-    if cols.sample_time.is_some() {
-        out.sample_time_rate_hz = rate_of_sample_time(&out.counters, &ticks);
+
+    /// The export, once its last line (1-based `last_line`, 0 for an empty
+    /// file) was read: an error without a header or without samples.
+    pub fn finish(mut self, last_line: u64) -> Result<XsensExport, TrialError> {
+        let origin = self.out.origin.as_str();
+        let Some(header) = &self.header else {
+            return Err(TrialError::at(
+                origin,
+                last_line.max(1),
+                1,
+                "no header: expected '// ...' comment lines then a header with PacketCounter",
+            ));
+        };
+        if self.out.counters.is_empty() {
+            return Err(TrialError::at(
+                origin,
+                last_line + 1,
+                1,
+                format!(
+                    "no samples: expected data rows after the header on line {}",
+                    header.line
+                ),
+            ));
+        }
+        if header.cols.sample_time.is_some() {
+            self.out.sample_time_rate_hz = rate_of_sample_time(&self.out.counters, &self.ticks);
+        }
+        Ok(self.out)
     }
-    Ok(out)
 }
 
 fn orientation(
     reader: &Cells,
     cells: &[&str],
     cols: &Columns,
-    header: &[&str],
+    header: &[String],
     line: u64,
     renormalised: &mut usize,
 ) -> Result<Quat, TrialError> {
     let origin = reader.origin;
     let mut v = [0.0f64; 9];
     for (slot, &k) in v.iter_mut().zip(&cols.fields) {
-        *slot = reader.number(cells, k, line, header[k])?;
+        *slot = reader.number(cells, k, line, &header[k])?;
     }
     let first = cols.fields[0] + 1;
     match cols.kind {

@@ -13,7 +13,7 @@
 //! (`Gyr_X Gyr_Y Gyr_Z`, rad/s, sensor frame) are aligned the same way.
 
 use super::mapping::{looks_like_mapping, parse_mapping, sensor_to_opensim, Mapping};
-use super::xsens::{parse_export, XsensExport, COUNTER_MODULUS};
+use super::xsens::{parse_export, ExportReader, XsensExport, COUNTER_MODULUS};
 use super::{ImuSeries, Trial, TrialError};
 use crate::model::Model;
 use crate::rotation::Quat;
@@ -344,6 +344,36 @@ pub(crate) fn trial_of_exports(
     exports: &[Vec<u8>],
     model: &Model,
 ) -> Result<Trial, TrialError> {
+    check_some_imu(path, source, model)?;
+    let mut parsed = Vec::with_capacity(source.files.len());
+    for ((f, name), bytes) in source.files.iter().zip(exports) {
+        let origin = f.display().to_string();
+        let text = crate::input::str_of(bytes)
+            .map_err(|e| TrialError::file(&origin, format!("cannot read: {}", e.error)))?;
+        parsed.push((name.clone(), parse_export(text, &origin)?));
+    }
+    assemble(&trial_name(path), parsed, rotation_of(source), model)
+}
+
+/// The name of the trial at `path`: its last component.
+fn trial_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// The mapping's `sensor_to_opensim_rotations`, if any.
+fn rotation_of(source: &XsensSource) -> Option<Quat> {
+    source
+        .mapping
+        .as_ref()
+        .and_then(|(_, m)| m.sensor_to_opensim_rad)
+        .map(sensor_to_opensim)
+}
+
+/// An error when no export of a trial of several (or of a folder) names an
+/// IMU of `model`.
+fn check_some_imu(path: &Path, source: &XsensSource, model: &Model) -> Result<(), TrialError> {
     let single = source.files.len() == 1 && source.files[0].0 == path;
     if !single
         && source
@@ -353,23 +383,189 @@ pub(crate) fn trial_of_exports(
     {
         return Err(no_imu_error(path, source, model));
     }
-    let mut parsed = Vec::with_capacity(source.files.len());
-    for ((f, name), bytes) in source.files.iter().zip(exports) {
-        let origin = f.display().to_string();
-        let text = crate::input::str_of(bytes)
-            .map_err(|e| TrialError::file(&origin, format!("cannot read: {}", e.error)))?;
-        parsed.push((name.clone(), parse_export(text, &origin)?));
+    Ok(())
+}
+
+/// Exports still being written (one per sensor, each appended to), aligned
+/// as they grow: the packets every sensor recorded, in counter order, as
+/// soon as every sensor has written past them, so that the rows handed
+/// out are those [`read_xsens_trial`] keeps of the finished exports, with
+/// the same times and orientations.
+///
+/// Two things are fixed when the first rows are handed out and not
+/// revisited: the wrap shifts (from each file's first counter, as the
+/// whole-file reader finds them) and the rate: the exports' `Update Rate`
+/// comment, else `SampleTimeFine` over the rows read by then (at least
+/// [`GROWING_RATE_ROWS`] per file), where the whole-file reader takes it
+/// over the whole export.
+pub struct GrowingExports {
+    name: String,
+    files: Vec<(PathBuf, String)>,
+    readers: Vec<ExportReader>,
+    rotation: Option<Quat>,
+    model: Model,
+    aligned: Option<Alignment>,
+}
+
+/// Rows each export has before a rate is taken from its `SampleTimeFine`.
+pub const GROWING_RATE_ROWS: usize = 16;
+
+/// What the first rows fixed.
+struct Alignment {
+    rate_hz: f64,
+    /// Added to each file's counters.
+    shifts: Vec<u64>,
+    /// The first packet every sensor may share.
+    start: u64,
+    /// Next row of the first file to look at.
+    next: usize,
+    /// Per file, the row the last shared packet was found at.
+    pos: Vec<usize>,
+}
+
+impl GrowingExports {
+    /// The exports of `source` (the trial named by `path`), read as their
+    /// lines arrive ([`GrowingExports::push_lines`]); an error when none of
+    /// them names an IMU of `model`.
+    pub fn new(path: &Path, source: &XsensSource, model: &Model) -> Result<Self, TrialError> {
+        check_some_imu(path, source, model)?;
+        Ok(GrowingExports {
+            name: trial_name(path),
+            files: source.files.clone(),
+            readers: (source.files.iter())
+                .map(|(f, _)| ExportReader::new(&f.display().to_string()))
+                .collect(),
+            rotation: rotation_of(source),
+            model: model.clone(),
+            aligned: None,
+        })
     }
-    let rotation = source
-        .mapping
-        .as_ref()
-        .and_then(|(_, m)| m.sensor_to_opensim_rad)
-        .map(sensor_to_opensim);
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| path.display().to_string());
-    assemble(&name, parsed, rotation, model)
+
+    /// Reads the complete lines `text` of export `k` (in the source's
+    /// order), whose first is 1-based line `first_line` of that file.
+    pub fn push_lines(&mut self, k: usize, text: &str, first_line: u64) -> Result<(), TrialError> {
+        self.readers[k].push_lines(text, first_line)
+    }
+
+    /// Whether every export's header line was read.
+    pub fn headers_read(&self) -> bool {
+        self.readers.iter().all(ExportReader::has_header)
+    }
+
+    /// The rows every sensor has written since the last call, aligned on
+    /// the packet counter, as a trial of those samples (`None`: no new row).
+    pub fn aligned(&mut self) -> Result<Option<Trial>, TrialError> {
+        if self.aligned.is_none() {
+            let Some(a) = self.first_alignment()? else {
+                return Ok(None);
+            };
+            self.aligned = Some(a);
+        }
+        let Some(a) = self.aligned.as_mut() else {
+            return Ok(None);
+        };
+        let exports: Vec<&XsensExport> = self.readers.iter().map(ExportReader::export).collect();
+        let shifts = a.shifts.clone();
+        let shifted = |k: usize, i: usize| exports[k].counters[i] + shifts[k];
+        // Every sensor has written past this packet: what it lacks, it lacks.
+        let end = (0..exports.len())
+            .map(|k| shifted(k, exports[k].counters.len() - 1))
+            .min()
+            .unwrap_or(0);
+        let mut kept: Vec<SharedPacket> = Vec::new();
+        while a.next < exports[0].counters.len() {
+            let c = shifted(0, a.next);
+            if c > end {
+                break;
+            }
+            a.next += 1;
+            if c < a.start {
+                continue;
+            }
+            let mut idx = Vec::with_capacity(exports.len());
+            for (k, e) in exports.iter().enumerate() {
+                while a.pos[k] < e.counters.len() && shifted(k, a.pos[k]) < c {
+                    a.pos[k] += 1;
+                }
+                if a.pos[k] < e.counters.len() && shifted(k, a.pos[k]) == c {
+                    idx.push(a.pos[k]);
+                }
+            }
+            if idx.len() == exports.len() {
+                kept.push((c, idx));
+            }
+        }
+        if kept.is_empty() {
+            return Ok(None);
+        }
+        let view: Vec<(&str, &XsensExport)> = (self.files.iter())
+            .zip(&exports)
+            .map(|((_, n), e)| (n.as_str(), *e))
+            .collect();
+        let mut ignored = Vec::new();
+        let imus = imu_series(&view, &kept, self.rotation, &self.model, &mut ignored)?;
+        let time_s = kept
+            .iter()
+            .map(|(c, _)| (c - a.start) as f64 / a.rate_hz)
+            .collect();
+        Ok(Some(Trial {
+            name: self.name.clone(),
+            time_s,
+            imus,
+            warnings: vec![],
+        }))
+    }
+
+    /// The rate and wrap shifts, once every export has its header and a
+    /// first row (and, for a rate from `SampleTimeFine`, enough rows).
+    fn first_alignment(&self) -> Result<Option<Alignment>, TrialError> {
+        let exports: Vec<&XsensExport> = self.readers.iter().map(ExportReader::export).collect();
+        if !self.headers_read() || exports.iter().any(|e| e.counters.is_empty()) {
+            return Ok(None);
+        }
+        let commented = exports.iter().any(|e| e.rate_hz.is_some());
+        let rows = exports.iter().map(|e| e.counters.len()).min().unwrap_or(0);
+        if !commented && rows < GROWING_RATE_ROWS {
+            return Ok(None);
+        }
+        // The exports' rates as the whole-file reader weighs them.
+        let heads: Vec<(String, XsensExport)> = (self.readers.iter())
+            .map(|r| {
+                let e = r.export();
+                let head = XsensExport {
+                    origin: e.origin.clone(),
+                    rate_hz: e.rate_hz,
+                    rate_at: e.rate_at,
+                    sample_time_rate_hz: r.sample_time_rate_hz(),
+                    coordinate_system: None,
+                    delimiter: e.delimiter,
+                    counters: vec![],
+                    lines: vec![],
+                    orientation: vec![],
+                    columns: e.columns,
+                    gyro: None,
+                    renormalised: 0,
+                };
+                (String::new(), head)
+            })
+            .collect();
+        let rate_hz = common_rate(&heads)?;
+        let firsts: Vec<u64> = exports.iter().map(|e| e.counters[0]).collect();
+        let shifts = wrap_shifts(&firsts);
+        let start = firsts
+            .iter()
+            .zip(&shifts)
+            .map(|(c, s)| c + s)
+            .max()
+            .unwrap_or(0);
+        Ok(Some(Alignment {
+            rate_hz,
+            shifts,
+            start,
+            next: 0,
+            pos: vec![0; exports.len()],
+        }))
+    }
 }
 
 /// The error for a folder or mapping none of whose sensors is an IMU of
@@ -446,19 +642,25 @@ fn mapping_template(files: &[(PathBuf, String)]) -> String {
 /// Counters shifted by whole wraps so that every file starts within half a
 /// wrap of the first file's start (files of one recording start together).
 fn align_wraps(exports: &mut [(String, XsensExport)]) {
-    let Some(reference) = exports.first().map(|(_, e)| e.counters[0] as i128) else {
-        return;
-    };
-    let m = COUNTER_MODULUS as i128;
-    let shifts: Vec<i128> = exports
-        .iter()
-        .map(|(_, e)| ((reference - e.counters[0] as i128) as f64 / m as f64).round() as i128 * m)
-        .collect();
-    let lowest = shifts.iter().copied().min().unwrap_or(0);
-    for ((_, e), s) in exports.iter_mut().zip(shifts) {
-        let s = (s - lowest) as u64;
+    let firsts: Vec<u64> = exports.iter().map(|(_, e)| e.counters[0]).collect();
+    for ((_, e), s) in exports.iter_mut().zip(wrap_shifts(&firsts)) {
         e.counters.iter_mut().for_each(|c| *c += s);
     }
+}
+
+/// What [`align_wraps`] adds to each file's counters, from each file's
+/// first (unwrapped) counter.
+fn wrap_shifts(firsts: &[u64]) -> Vec<u64> {
+    let Some(&reference) = firsts.first() else {
+        return vec![];
+    };
+    let m = COUNTER_MODULUS as i128;
+    let shifts: Vec<i128> = firsts
+        .iter()
+        .map(|&c| ((reference as i128 - c as i128) as f64 / m as f64).round() as i128 * m)
+        .collect();
+    let lowest = shifts.iter().copied().min().unwrap_or(0);
+    shifts.into_iter().map(|s| (s - lowest) as u64).collect()
 }
 
 fn common_rate(exports: &[(String, XsensExport)]) -> Result<f64, TrialError> {
@@ -564,7 +766,8 @@ pub(crate) fn assemble(
     let (start, end, kept) = shared_packets(&exports)?;
     let mut warnings: Vec<String> = frame_warning(&exports).into_iter().collect();
     warnings.extend(coverage_warnings(&exports, start, end, kept.len()));
-    let imus = imu_series(&exports, &kept, rotation, model, &mut warnings)?;
+    let view: Vec<(&str, &XsensExport)> = exports.iter().map(|(n, e)| (n.as_str(), e)).collect();
+    let imus = imu_series(&view, &kept, rotation, model, &mut warnings)?;
     let time_s: Vec<f64> = kept
         .iter()
         .map(|(c, _)| (c - start) as f64 / rate)
@@ -698,14 +901,14 @@ fn coverage_warnings(
 /// at the `kept` packets, named through `model`'s aliases; warnings for
 /// IMUs the model lacks and for renormalised quaternions.
 fn imu_series(
-    exports: &[(String, XsensExport)],
+    exports: &[(&str, &XsensExport)],
     kept: &[SharedPacket],
     rotation: Option<Quat>,
     model: &Model,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<ImuSeries>, TrialError> {
     let mut imus: Vec<ImuSeries> = Vec::with_capacity(exports.len());
-    for (k, (found, e)) in exports.iter().enumerate() {
+    for (k, &(found, e)) in exports.iter().enumerate() {
         let canonical = match model.canonical_imu(found) {
             Some(c) => c.to_string(),
             None => {
@@ -714,7 +917,7 @@ fn imu_series(
                     file_name(&e.origin),
                     model.name
                 ));
-                found.clone()
+                found.to_string()
             }
         };
         if let Some(prev) = imus.iter().position(|s| s.name == canonical) {

@@ -726,6 +726,22 @@ impl Workbench {
         Some(effect)
     }
 
+    /// Whether `file` is still growing (followed, or its final reading not
+    /// yet in): then `w` is refused, with a status message saying that it
+    /// waits for the final correction, since a half trial saved under the
+    /// final output's name would pass for the whole one.
+    pub fn refuse_save_while_growing(&mut self, file: &str) -> bool {
+        let growing = self
+            .entry(file)
+            .is_some_and(|e| e.following.is_some() || e.live.is_some());
+        if growing {
+            self.error(format!(
+                "{file} is still growing: w waits for the final correction (made once it stops growing)"
+            ));
+        }
+        growing
+    }
+
     /// The job following `file` as it grows, corrected with the variant
     /// shown (replacing any earlier follow of it).
     pub fn follow_effect(&mut self, file: &str) -> Option<Effect> {

@@ -215,13 +215,14 @@ impl LiveJob {
         let loaded = Arc::new(Loaded {
             trial,
             model: self.model.clone(),
-            // A growing file has no hash yet: its final reload (read whole)
-            // brings the source its saved corrections record.
+            // The hash of the bytes read so far: once the writer stops and
+            // every byte was read, the whole file's, as its final reload
+            // (read whole) records it.
             source: crate::correct::pipeline::Source {
                 path: self.job.path.clone(),
                 format,
                 gzip: false,
-                sha256: String::new(),
+                sha256: self.tail.sha256_hex(),
             },
             truth: None,
             truth_error: None,

@@ -402,6 +402,9 @@ pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
             app.info(format!("chose {v}; w saves it"));
         }
         Action::Save => {
+            if app.refuse_save_while_growing(&file) {
+                return Reply::default();
+            }
             let v = app
                 .entry(&file)
                 .and_then(|e| e.chosen)

@@ -723,6 +723,12 @@ pub fn action(app: &mut Workbench, a: Action) -> Reply {
         Action::Stick => return Reply::nav(Nav::View(ViewKind::Stick)),
         Action::HeadingDrift => return Reply::nav(Nav::View(ViewKind::Heading)),
         Action::Compare => return Reply::nav(Nav::Compare),
+        // Saving is the compare screen's; a growing trial says why it waits.
+        Action::Save => {
+            if let Some(f) = app.open.clone() {
+                app.refuse_save_while_growing(&f);
+            }
+        }
         Action::Run => {
             if let Some(f) = app.open.clone() {
                 return app.run_effect(&f, None).into();

@@ -261,3 +261,84 @@ fn a_truncated_growing_trial_starts_over() {
     assert!(update(&mut app, stale).is_empty());
     assert!(app.entry("live.csv").unwrap().following.is_some());
 }
+
+/// `w` while the trial grows is refused with a status message (a half trial
+/// saved under the final output's name would pass for the whole one); once
+/// the writer stopped and the trial was corrected whole, `w` saves, and the
+/// sidecar records the file's SHA-256, so that a new session finds the
+/// output saved. The live trial's source carries the hash of the bytes read.
+#[test]
+fn a_save_waits_for_the_final_correction_and_records_the_file_hash() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("trials");
+    std::fs::create_dir_all(&dir).unwrap();
+    let limits = tmp.path().join("joint_limits");
+    let mut cfg = crate::simulate::preset("knee_calf_z15").unwrap();
+    cfg.duration_s = 30.0;
+    let sim = crate::simulate::simulate(&cfg).unwrap();
+    let text = trial_to_string(&sim.trial, TrialFormat::QuatCsv);
+    let path = dir.join("live.csv");
+    std::fs::write(&path, "").unwrap();
+    let mut app = load_app("trials", &dir, &limits).unwrap();
+    let fx = update(&mut app, Msg::FileChanged("live.csv".into(), path.clone()));
+    let [Effect::Follow(job)] = fx.as_slice() else {
+        panic!("{fx:?}")
+    };
+    let mut live = LiveJob::new((**job).clone());
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(16);
+    // 14 s of rows and part of the next line.
+    let cut = row_at(&text, 700) + 5;
+    append_in_fragments(&path, &text[..cut], &mut rng, &mut app, &mut live);
+    settle(&mut app, &mut live);
+    let hash_of_file = || crate::input::sha256_hex(&std::fs::read(&path).unwrap());
+    let l = app.entry("live.csv").unwrap().loaded().unwrap().clone();
+    assert_eq!(l.trial.len(), 700);
+    // Every byte written so far was read (the half line too): its hash.
+    assert_eq!(l.source.sha256, hash_of_file());
+    act(&mut app, Action::Enter);
+    assert_eq!(app.screen, Screen::Trial);
+    // On the trial screen and on the compare screen, `w` waits.
+    assert!(act(&mut app, Action::Save).is_empty());
+    let (msg, is_error) = app.message.clone().unwrap();
+    assert!(
+        is_error && msg.contains("waits for the final correction"),
+        "{msg}"
+    );
+    app.message = None;
+    act(&mut app, Action::Compare);
+    assert_eq!(app.screen, Screen::Compare);
+    assert!(act(&mut app, Action::Save).is_empty());
+    let (msg, is_error) = app.message.clone().unwrap();
+    assert!(
+        is_error && msg.contains("live.csv is still growing") && msg.contains("final correction"),
+        "{msg}"
+    );
+    assert!(!dir.join("corrected").exists(), "nothing was saved");
+    // The writer writes the rest and stops.
+    append_in_fragments(&path, &text[cut..], &mut rng, &mut app, &mut live);
+    settle(&mut app, &mut live);
+    let l = app.entry("live.csv").unwrap().loaded().unwrap().clone();
+    assert_eq!(l.trial.len(), sim.trial.len());
+    assert_eq!(l.source.sha256, hash_of_file());
+    let fx = update(&mut app, live.finish(Ok(())));
+    SyncRunner::run(&mut app, fx);
+    let e = app.entry("live.csv").unwrap();
+    assert!(e.live.is_none() && e.following.is_none());
+    assert_eq!(e.results.len(), Variant::ALL.len());
+    // Final: `w` saves the variant of the compare column.
+    let v = Variant::ALL[app.compare_col];
+    let fx = act(&mut app, Action::Save);
+    assert!(
+        matches!(fx.as_slice(), [Effect::SaveVariant { .. }]),
+        "{fx:?}"
+    );
+    SyncRunner::run(&mut app, fx);
+    let out = dir.join(format!("corrected/live.{v}.csv"));
+    assert!(out.is_file(), "{:?}", app.message);
+    let sc = crate::sidecar::Sidecar::load(&crate::sidecar::sidecar_path(&out)).unwrap();
+    assert_eq!(sc.variant, v);
+    assert_eq!(sc.input.sha256, hash_of_file());
+    // A new session over the folder finds it saved.
+    let again = load_app("trials", &dir, &limits).unwrap();
+    assert_eq!(again.entry("live.csv").unwrap().variant_status(v), "saved");
+}
