@@ -3,6 +3,7 @@
 //! Every problem becomes a [`TrialError`] with the 1-based line and column
 //! (field index) and what was expected; nothing here panics on any input.
 
+use super::number::parse_f64;
 use crate::model::Model;
 use crate::rotation::{quat_from_euler_zyx_deg, Quat};
 use crate::trial::{ImuSeries, Trial, TrialError, TrialFormat};
@@ -689,7 +690,7 @@ fn number(
     what: &str,
 ) -> Result<f64, TrialError> {
     let t = cell.trim_ascii();
-    match t.parse::<f64>() {
+    match parse_f64(t) {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(TrialError::at(
             origin,
@@ -831,10 +832,10 @@ pub(crate) fn parse_rows(
                     }
                     let mut q = [0.0f64; 4];
                     for ((v, part), p) in q.iter_mut().zip(cell.split(',')).zip(PARTS) {
-                        let what = format!("{} {p}", imu.found);
-                        *v = match part.trim_ascii().parse::<f64>() {
+                        *v = match parse_f64(part.trim_ascii()) {
                             Ok(v) if v.is_finite() => v,
-                            _ => number(part, origin, line, col, &what)?,
+                            // The column's name is built only for the message.
+                            _ => number(part, origin, line, col, &format!("{} {p}", imu.found))?,
                         };
                     }
                     acc.push_quat(k, q, line, col, &imu.found)?;
