@@ -202,7 +202,7 @@ mod tests {
             f64::EPSILON,
             5e-324,
             -5e-324,
-            2.2250738585072009e-308,
+            f64::from_bits(0x000f_ffff_ffff_ffff), // largest subnormal
             0.30000000000000004,
             9007199254740993.0,
             f64::NAN,
