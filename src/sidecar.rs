@@ -10,7 +10,7 @@ use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
 use crate::pose::PoseRecord;
 use crate::save::{atomic_write, OutputLock};
-use crate::trial::{write_trial, Trial, TrialFormat};
+use crate::trial::{write_trial_hashed, Trial, TrialFormat};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -348,10 +348,9 @@ impl SaveRequest<'_> {
         }
         let _lock = OutputLock::acquire(self.output)
             .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", self.output.display()))?;
-        write_trial(&self.correction.corrected, self.output, self.output_format)?;
-        let written = std::fs::read(self.output)
-            .map_err(|e| anyhow::anyhow!("{}: cannot read back: {e}", self.output.display()))?;
-        sidecar.output_sha256 = Some(sha256_hex(&written));
+        let written =
+            write_trial_hashed(&self.correction.corrected, self.output, self.output_format)?;
+        sidecar.output_sha256 = Some(written);
         if let Some(run) = &self.correction.ik {
             write_coordinates(run, &coordinates_path(self.output))?;
         }

@@ -30,9 +30,11 @@ use std::io::{BufRead, BufReader, Read, Write as _};
 use std::path::{Path, PathBuf};
 
 mod file;
+pub(crate) mod number;
 pub(crate) mod parse;
 
 pub use file::TrialFile;
+use number::push_f64;
 use parse::{classify_csv_header, first_header, parse_header, parse_trial, LineIter};
 
 /// A cheap look at a trial file: its format and IMUs, without the samples.
@@ -420,6 +422,17 @@ pub fn write_trial(
     path: &Path,
     format: TrialFormat,
 ) -> Result<(), crate::save::WriteError> {
+    write_trial_hashed(trial, path, format).map(|_| ())
+}
+
+/// [`write_trial`], returning the SHA-256 (hex) of the bytes written (the
+/// file as stored, compressed when gzip), hashed from memory as they go to
+/// disk rather than read back.
+pub fn write_trial_hashed(
+    trial: &Trial,
+    path: &Path,
+    format: TrialFormat,
+) -> Result<String, crate::save::WriteError> {
     let origin = origin_of(path);
     let refused = |message: String| crate::save::WriteError {
         path: origin.clone(),
@@ -480,7 +493,19 @@ pub fn write_trial(
     } else {
         text.into_bytes()
     };
-    crate::save::atomic_write(path, &bytes).map_err(|e| crate::save::WriteError::io(path, &e))
+    let sha256 = crate::input::sha256_hex(&bytes);
+    crate::save::atomic_write(path, &bytes).map_err(|e| crate::save::WriteError::io(path, &e))?;
+    Ok(sha256)
+}
+
+/// Appends `first` then the numbers of `values` separated by `sep`, each as
+/// `{}` writes it ([`push_f64`]).
+#[inline]
+fn push_cells(out: &mut String, first: char, sep: char, values: &[f64]) {
+    for (k, &v) in values.iter().enumerate() {
+        out.push(if k == 0 { first } else { sep });
+        push_f64(out, v);
+    }
 }
 
 /// The text of a trial in `format` (uncompressed). Numbers use Rust's shortest
@@ -517,19 +542,18 @@ pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
             }
             out.push('\n');
             for i in 0..n {
-                let _ = write!(out, "{}", trial.time_s[i]);
+                push_f64(&mut out, trial.time_s[i]);
                 for s in &trial.imus {
                     let q = &s.orientation[i];
                     if format == TrialFormat::QuatCsv {
                         let q = canonical(q);
-                        let _ = write!(out, ",{},{},{},{}", q.w, q.i, q.j, q.k);
+                        push_cells(&mut out, ',', ',', &[q.w, q.i, q.j, q.k]);
                     } else {
-                        let [r, p, y] = euler_zyx_deg(q);
-                        let _ = write!(out, ",{r},{p},{y}");
+                        push_cells(&mut out, ',', ',', &euler_zyx_deg(q));
                     }
                     if let Some(g) = &s.gyro {
                         let w = &g[i];
-                        let _ = write!(out, ",{},{},{}", w.x, w.y, w.z);
+                        push_cells(&mut out, ',', ',', &[w.x, w.y, w.z]);
                     }
                 }
                 out.push('\n');
@@ -546,10 +570,10 @@ pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
             }
             out.push('\n');
             for i in 0..n {
-                let _ = write!(out, "{}", trial.time_s[i]);
+                push_f64(&mut out, trial.time_s[i]);
                 for s in &trial.imus {
                     let q = canonical(&s.orientation[i]);
-                    let _ = write!(out, "\t{},{},{},{}", q.w, q.i, q.j, q.k);
+                    push_cells(&mut out, '\t', ',', &[q.w, q.i, q.j, q.k]);
                 }
                 out.push('\n');
             }

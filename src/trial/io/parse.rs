@@ -3,6 +3,7 @@
 //! Every problem becomes a [`TrialError`] with the 1-based line and column
 //! (field index) and what was expected; nothing here panics on any input.
 
+use super::number::parse_f64;
 use crate::model::Model;
 use crate::rotation::{quat_from_euler_zyx_deg, Quat};
 use crate::trial::{ImuSeries, Trial, TrialError, TrialFormat};
@@ -689,7 +690,7 @@ fn number(
     what: &str,
 ) -> Result<f64, TrialError> {
     let t = cell.trim_ascii();
-    match t.parse::<f64>() {
+    match parse_f64(t) {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(TrialError::at(
             origin,
@@ -712,8 +713,22 @@ fn number(
     }
 }
 
-fn count_fields(line: &str, sep: u8) -> usize {
-    line.bytes().filter(|&b| b == sep).count() + 1
+/// Replaces `cells` with the fields of `line` separated by the ASCII byte
+/// `sep`, in one pass over its bytes; returns their number.
+#[inline]
+fn split_into<'a>(line: &'a str, sep: u8, cells: &mut Vec<&'a str>) -> usize {
+    debug_assert!(sep.is_ascii());
+    cells.clear();
+    let mut start = 0;
+    for (i, &b) in line.as_bytes().iter().enumerate() {
+        if b == sep {
+            // An ASCII separator is always a character boundary.
+            cells.push(&line[start..i]);
+            start = i + 1;
+        }
+    }
+    cells.push(&line[start..]);
+    cells.len()
 }
 
 fn ragged(origin: &str, line: u64, expected: usize, found: usize, unit: &str) -> TrialError {
@@ -775,12 +790,10 @@ pub(crate) fn parse_rows(
                 if text.trim().is_empty() {
                     continue;
                 }
-                let nf = count_fields(text, b',');
+                let nf = split_into(text, b',', &mut cells);
                 if nf != ncols {
                     return Err(ragged(origin, line, ncols, nf, "comma"));
                 }
-                cells.clear();
-                cells.extend(text.split(','));
                 let cell =
                     |col: usize| number(cells[col], origin, line, col + 1, &layout.columns[col]);
                 let t = number(cells[0], origin, line, 1, "time")?;
@@ -802,21 +815,22 @@ pub(crate) fn parse_rows(
         }
         TrialFormat::Sto | TrialFormat::Xsens => {
             const PARTS: [&str; 4] = ["w", "x", "y", "z"];
+            let mut cells: Vec<&str> = Vec::with_capacity(ncols);
+            let mut split: Vec<&str> = Vec::with_capacity(4);
             for (line, text) in lines.by_ref() {
                 if text.trim().is_empty() {
                     continue;
                 }
-                let nf = count_fields(text, b'\t');
+                let nf = split_into(text, b'\t', &mut cells);
                 if nf != ncols {
                     return Err(ragged(origin, line, ncols, nf, "tab"));
                 }
-                let mut cells = text.split('\t');
-                let t = number(cells.next().unwrap_or(""), origin, line, 1, "time")?;
+                let t = number(cells[0], origin, line, 1, "time")?;
                 acc.push_time(t, line)?;
-                for (k, imu) in layout.imus.iter().enumerate() {
+                // The IMUs' cells follow `time` in order (one per label).
+                for ((k, imu), &cell) in layout.imus.iter().enumerate().zip(&cells[1..]) {
                     let col = imu.first_field + 1;
-                    let cell = cells.next().unwrap_or("");
-                    let parts = count_fields(cell, b',');
+                    let parts = split_into(cell, b',', &mut split);
                     if parts != 4 {
                         return Err(TrialError::at(
                             origin,
@@ -830,11 +844,11 @@ pub(crate) fn parse_rows(
                         ));
                     }
                     let mut q = [0.0f64; 4];
-                    for ((v, part), p) in q.iter_mut().zip(cell.split(',')).zip(PARTS) {
-                        let what = format!("{} {p}", imu.found);
-                        *v = match part.trim_ascii().parse::<f64>() {
+                    for ((v, &part), p) in q.iter_mut().zip(&split).zip(PARTS) {
+                        *v = match parse_f64(part.trim_ascii()) {
                             Ok(v) if v.is_finite() => v,
-                            _ => number(part, origin, line, col, &what)?,
+                            // The column's name is built only for the message.
+                            _ => number(part, origin, line, col, &format!("{} {p}", imu.found))?,
                         };
                     }
                     acc.push_quat(k, q, line, col, &imu.found)?;
