@@ -274,6 +274,11 @@ fn compare_scrolls_to_the_baselines_and_saves_one() {
     assert_eq!(app.open_entry().unwrap().chosen, Some(Variant::Mueller));
     // At 80 columns the variants scroll: rivest and mueller are in view.
     snap("compare_baselines", &app);
+    // Short of rows even in two columns, the status list scrolls to the
+    // selected variant and says where it is.
+    let small = super::headless::buffer_text(&draw(&app, &Theme::default(), 60, 16));
+    assert!(small.contains("status, variant 7/11"), "{small}");
+    assert!(small.contains("> mueller"), "{small}");
     keys(&mut app, "w");
     let out = fx.root().join("trials/corrected/fb.mueller.csv.gz");
     assert!(out.exists(), "{:?}", app.message);

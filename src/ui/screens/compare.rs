@@ -605,3 +605,41 @@ pub fn action(col: &mut usize, app: &mut Workbench, a: Action) -> Reply {
     }
     Reply::default()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whatever the room, the status list holds every variant (columns times
+    /// rows), keeps the selected one in view, and shows every row whenever
+    /// the joints can keep their minimum beside it.
+    #[test]
+    fn the_status_list_keeps_every_variant_reachable() {
+        let n = Variant::ALL.len();
+        for width in [40, 60, 80, 120] {
+            for avail in 0..30 {
+                for joints in [1, 12] {
+                    for selected in 0..n {
+                        let g = status_geometry(avail, width, joints, selected);
+                        let what =
+                            format!("{width} wide, {avail} rows, {joints} joints, {selected}");
+                        assert!(g.cols * g.rows >= n, "{what}: {g:?}");
+                        assert!(g.shown >= 1 && g.first + g.shown <= g.rows, "{what}: {g:?}");
+                        let row = selected % g.rows;
+                        assert!((g.first..g.first + g.shown).contains(&row), "{what}: {g:?}");
+                        if joints.min(MIN_JOINTS) + g.rows + usize::from(g.cols > 1) <= avail {
+                            assert!(!g.scrolled(), "{what}: {g:?}");
+                        }
+                    }
+                }
+            }
+        }
+        // 80x24 with twelve joints: two columns of six, every row shown.
+        let g = status_geometry(22 - 7, 80, 12, 1);
+        assert_eq!((g.cols, g.rows, g.shown), (2, 6, 6));
+        // Too short even in two columns: rows scroll to the selection.
+        let g = status_geometry(6, 60, 12, 5);
+        assert_eq!((g.cols, g.rows, g.shown, g.first), (2, 6, 2, 4));
+        assert!(g.scrolled());
+    }
+}
