@@ -150,6 +150,7 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "v", code: &[KeyCode::Char('v')], action: Action::Variant, scope: Scope::Trials, help: "next variant" },
     Binding { keys: "H", code: &[KeyCode::Char('H')], action: Action::Histogram, scope: Scope::Trials, help: "histograms of the listed trials" },
     Binding { keys: "Left/Right", code: &[KeyCode::Left], action: Action::Left, scope: Scope::Compare, help: "pick the variant column" },
+    Binding { keys: "", code: &[KeyCode::Right], action: Action::Right, scope: Scope::Compare, help: "" },
     Binding { keys: "w", code: &[KeyCode::Char('w')], action: Action::Save, scope: Scope::Compare, help: "save the chosen variant" },
     Binding { keys: "o", code: &[KeyCode::Char('o')], action: Action::Globe, scope: Scope::Compare, help: "override auto's choice for the joint" },
     Binding { keys: "r", code: &[KeyCode::Char('r')], action: Action::Run, scope: Scope::Compare, help: "run all variants again" },
@@ -162,8 +163,11 @@ pub const BINDINGS: &[Binding] = &[
     Binding { keys: "Enter", code: &[KeyCode::Enter], action: Action::Enter, scope: Scope::Histogram, help: "suggest limits (90% intervals)" },
     Binding { keys: "w", code: &[KeyCode::Char('w')], action: Action::Save, scope: Scope::Histogram, help: "write centroids.csv (asks)" },
     Binding { keys: "Left/Right", code: &[KeyCode::Left], action: Action::Left, scope: Scope::Histogram, help: "previous / next span" },
+    Binding { keys: "", code: &[KeyCode::Right], action: Action::Right, scope: Scope::Histogram, help: "" },
     Binding { keys: "+/-", code: &[KeyCode::Char('+')], action: Action::ZoomIn, scope: Scope::Histogram, help: "span length" },
+    Binding { keys: "", code: &[KeyCode::Char('-')], action: Action::ZoomOut, scope: Scope::Histogram, help: "" },
     Binding { keys: "Home/End", code: &[KeyCode::Home], action: Action::Home, scope: Scope::Histogram, help: "first 30 s / whole trial" },
+    Binding { keys: "", code: &[KeyCode::End], action: Action::End, scope: Scope::Histogram, help: "" },
 ];
 
 /// The action of a key press, if any. Of the Ctrl-combinations only Ctrl-C
