@@ -29,7 +29,8 @@ fn column_label(v: Variant) -> &'static str {
 const NAME_W: usize = 12;
 /// Width of one entry of the status list when it runs in several columns.
 const STATUS_W: usize = 30;
-/// Joint rows kept in view before the status list is let scroll.
+/// Joint rows kept in view (when the trial has that many) before the
+/// status list scrolls.
 const MIN_JOINTS: usize = 3;
 
 /// Where the compare screen puts things in an area: the variant columns in
@@ -90,7 +91,7 @@ fn status_geometry(avail: usize, width: usize, joints: usize, selected: usize) -
     let rows = n.div_ceil(cols);
     let detail = usize::from(cols > 1);
     let keep = joints.min(MIN_JOINTS);
-    let shown = if joints + rows + detail <= avail || keep + rows + detail <= avail {
+    let shown = if keep + rows + detail <= avail {
         rows
     } else {
         avail.saturating_sub(keep + detail).clamp(1, rows)
@@ -379,15 +380,14 @@ fn status_lines(
     let marker = |k: usize| if k == col { "> " } else { "  " };
     if g.cols == 1 {
         for (k, v) in Variant::ALL.iter().enumerate().skip(g.first).take(g.shown) {
-            let saved = saved_path(e, *v)
-                .map(|p| format!(" -> {p}"))
-                .unwrap_or_default();
-            let text = format!(
-                "{}{:<24}{}{saved}",
-                marker(k),
-                v.name(),
-                e.variant_status(*v)
-            );
+            let mut text = format!("{}{:<24}{}", marker(k), v.name(), e.variant_status(*v));
+            if let Some(p) = saved_path(e, *v) {
+                text.push_str(&format!(" -> {p}"));
+            }
+            // The selected variant's line also says what it skipped.
+            if let Some(note) = e.variant_note(*v).filter(|_| k == col) {
+                text.push_str(&format!("; {note}"));
+            }
             lines.push(
                 Line::from(fit(&text, width).trim_end().to_string()).style(sel(theme, k == col)),
             );
