@@ -247,11 +247,11 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
             }
             match result {
                 Ok(out) => {
-                    if let Some(r) = app
-                        .entry_mut(&file)
-                        .and_then(|e| e.results.get_mut(&variant))
-                    {
-                        r.saved = Some(out.clone());
+                    if let Some(e) = app.entry_mut(&file) {
+                        e.written.insert(variant, out.clone());
+                        if let Some(r) = e.results.get_mut(&variant) {
+                            r.saved = Some(out.clone());
+                        }
                     }
                     app.info(format!("saved {out}"));
                 }

@@ -230,7 +230,7 @@ fn help(app: &App, theme: &Theme, f: &mut Frame, body: Rect) {
         " Keys (any key closes) ".to_string()
     } else {
         format!(
-            " Keys {}-{} of {n} (Up/Down PgUp/PgDn scroll, other keys close) ",
+            " Keys {}-{} of {n}: Up/Down PgUp/PgDn scroll, others close ",
             first + 1,
             (first + inner_h).min(n)
         )

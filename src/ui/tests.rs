@@ -274,6 +274,11 @@ fn compare_scrolls_to_the_baselines_and_saves_one() {
     assert_eq!(app.open_entry().unwrap().chosen, Some(Variant::Mueller));
     // At 80 columns the variants scroll: rivest and mueller are in view.
     snap("compare_baselines", &app);
+    // Short of rows even in two columns, the status list scrolls to the
+    // selected variant and says where it is.
+    let small = super::headless::buffer_text(&draw(&app, &Theme::default(), 60, 16));
+    assert!(small.contains("status, variant 7/11"), "{small}");
+    assert!(small.contains("> mueller"), "{small}");
     keys(&mut app, "w");
     let out = fx.root().join("trials/corrected/fb.mueller.csv.gz");
     assert!(out.exists(), "{:?}", app.message);
@@ -725,7 +730,13 @@ fn fingerprint(app: &App) -> String {
                 app.limits.row,
                 app.quit
             ),
-            (app.views.kind, app.views.time_colour, app.calib.selected),
+            (
+                app.views.kind,
+                app.views.time_colour,
+                app.views.playing,
+                app.calib.selected,
+                app.view.braille,
+            ),
             app.histogram.as_ref().map(|h| {
                 (
                     h.span,
@@ -801,6 +812,88 @@ fn every_hint_does_what_it_says() {
                 }
             }
             assert!(did, "{what} did nothing");
+        }
+    }
+}
+
+/// Every key the help of a screen lists under that screen does something
+/// there (from a state where it can), and every key the screen's status bar
+/// hints at is in its help. The keys that answer a question (`K`/`T` of the
+/// reload conflict) are pressed in `reload_conflict_keep_or_take`. Driven
+/// through `update`; nothing sleeps.
+#[test]
+fn every_key_in_every_screens_help_does_something() {
+    use super::keymap::{self, hints, Action, Scope, BINDINGS};
+    let fx = Fixture::new();
+    let base = fx.app();
+    let key_of = |a: Action| {
+        let b = BINDINGS.iter().find(|b| b.action == a).unwrap();
+        KeyEvent::from(b.code[0])
+    };
+    for (screen, setup) in [
+        ("trials", ""),
+        ("trial", "+"),
+        ("compare", ""),
+        ("limits", ""),
+        ("scatter", ""),
+        ("calibration", ""),
+        ("histogram", ""),
+    ] {
+        let mut app = base.clone();
+        shown(&mut app, screen, "knee.csv");
+        keys(&mut app, setup);
+        app.message = None;
+        let scope = super::render::scope_of(app.screen);
+        let in_help = |a: Action| {
+            BINDINGS
+                .iter()
+                .any(|b| b.action == a && (b.scope == scope || b.scope == Scope::Everywhere))
+        };
+        for h in hints(scope) {
+            assert!(
+                in_help(h.action),
+                "{screen}: hint `{} {}` is not in the help",
+                h.keys,
+                h.text
+            );
+        }
+        let own = BINDINGS.iter().filter(|b| b.scope == scope);
+        for b in own.filter(|b| !matches!(b.action, Action::KeepMine | Action::TakeFile)) {
+            for code in b.code {
+                let what = format!("{screen}: {code:?} ({})", b.help);
+                assert_eq!(
+                    keymap::action(&KeyEvent::from(*code)),
+                    Some(b.action),
+                    "{what}"
+                );
+                let prep = match b.action {
+                    Action::Home => Some(Action::End),
+                    Action::End => Some(Action::Home),
+                    Action::Left => Some(Action::Right),
+                    Action::Right => Some(Action::Left),
+                    Action::ZoomOut => Some(Action::ZoomIn),
+                    Action::CursorLeft => Some(Action::CursorRight),
+                    Action::Scatter => Some(Action::Globe),
+                    Action::Play => Some(Action::Stick),
+                    _ => None,
+                };
+                let acts = |from: &App| {
+                    let mut a = from.clone();
+                    let before = fingerprint(&a);
+                    let effects = update(&mut a, Msg::Key(KeyEvent::from(*code)));
+                    !effects.is_empty() || fingerprint(&a) != before
+                };
+                let mut did = acts(&app);
+                if !did {
+                    if let Some(p) = prep {
+                        let mut from = app.clone();
+                        SyncRunner::send(&mut from, Msg::Key(key_of(p)));
+                        from.message = None;
+                        did = acts(&from);
+                    }
+                }
+                assert!(did, "{what} did nothing");
+            }
         }
     }
 }

@@ -58,6 +58,12 @@ pub struct TrialEntry {
     pub live: Option<LiveTrace>,
     /// Correct every variant once the trial is read whole (it stopped growing).
     pub correct_when_loaded: bool,
+    /// Outputs written this session: variant -> path as shown (relative to
+    /// the trial's folder).
+    pub written: BTreeMap<Variant, String>,
+    /// A save over an output of another correction of this trial, waiting
+    /// for y (overwrite) or n.
+    pub overwrite: Option<Variant>,
 }
 
 impl TrialEntry {
@@ -75,6 +81,8 @@ impl TrialEntry {
             following: None,
             live: None,
             correct_when_loaded: false,
+            written: BTreeMap::new(),
+            overwrite: None,
         }
     }
 

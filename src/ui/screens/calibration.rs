@@ -9,7 +9,7 @@
 
 use crate::calibration::Calibration;
 use crate::rotation::angle_deg;
-use crate::ui::cells::{fit, sel};
+use crate::ui::cells::{counter, fit, sel};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{CalibEntry, Effect, Nav, Reply, Screen};
 use crate::ui::theme::Theme;
@@ -95,7 +95,14 @@ fn render_list(c: &CalibState, theme: &Theme, f: &mut Frame, area: Rect) {
     let mut lines = vec![Line::from(Span::styled(
         format!(
             "  {}{:>8}{:>6}{:>7}{:>9}",
-            fit(&format!("recording (protocol {})", c.protocol), nw),
+            fit(
+                &format!(
+                    "recording {} (protocol {})",
+                    counter(c.selected, c.entries.len()),
+                    c.protocol
+                ),
+                nw
+            ),
             "dur s",
             "IMUs",
             "moves",

@@ -14,7 +14,7 @@ use crate::analysis::histogram::{AxisHistogram, JointHistogram};
 use crate::analysis::suggest::{suggest_limits, SuggestOptions, Suggestion};
 use crate::analysis::TimeSpan;
 use crate::limits::axis_name;
-use crate::ui::cells::{centred, fit, sel};
+use crate::ui::cells::{centred, counter, fit, sel};
 use crate::ui::keymap::Action;
 use crate::ui::msg::{Computed, Effect, Nav, Reply, RowAnalysis, Screen};
 use crate::ui::theme::Theme;
@@ -398,7 +398,14 @@ pub fn render(
 fn joint_list(st: &HistogramState, theme: &Theme, f: &mut Frame, area: Rect) {
     let w = area.width.saturating_sub(1) as usize;
     let mut lines = vec![Line::from(Span::styled(
-        fit(&format!("{} trial(s)", st.files.len()), w),
+        fit(
+            &format!(
+                "joint {}, {} trial(s)",
+                counter(st.joint, st.hists.len()),
+                st.files.len()
+            ),
+            w,
+        ),
         theme.header,
     ))];
     let rows = area.height.saturating_sub(1) as usize;

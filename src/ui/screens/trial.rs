@@ -760,8 +760,11 @@ fn next_glitch(app: &mut Workbench) {
         return;
     };
     let found = crate::ui::glitches::of_joint(l, &joint);
-    if let Some(t) = crate::ui::glitches::next_after(&found, app.view.cursor_s) {
-        app.view.cursor_s = t;
+    match crate::ui::glitches::next_after(&found, app.view.cursor_s) {
+        Some(t) => app.view.cursor_s = t,
+        // Said, not silently ignored.
+        None if found.is_empty() => app.info(format!("{joint}: no glitches")),
+        None => app.info(format!("{joint}: no glitch after the cursor")),
     }
 }
 

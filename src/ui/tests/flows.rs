@@ -150,6 +150,64 @@ fn saved_outputs_are_found_again_after_a_restart() {
     assert_eq!(third.entry("fb.csv.gz").unwrap().variant_status(v), "-");
 }
 
+/// `w` over an output of another correction of the trial (its sidecar
+/// records another limit table) asks; `n` keeps the file, `y` writes. A save
+/// of the very correction on disk asks nothing.
+#[test]
+fn saving_over_another_corrections_output_asks() {
+    let fx = Fixture::new();
+    let mut app = fx.app();
+    app.select_file("fb.csv.gz");
+    key(&mut app, KeyCode::Enter);
+    keys(&mut app, "rc");
+    key(&mut app, KeyCode::Char(' '));
+    keys(&mut app, "w");
+    let v = app.open_entry().unwrap().chosen.unwrap();
+    let out = fx.root().join(format!("trials/corrected/fb.{v}.csv.gz"));
+    let side = crate::sidecar::sidecar_path(&out);
+    let json = std::fs::read_to_string(&side).unwrap();
+    let hash = crate::sidecar::Sidecar::load(&side).unwrap().limits.sha256;
+    let other = "1".repeat(hash.len());
+    std::fs::write(&side, json.replace(&hash, &other)).unwrap();
+    let written = std::fs::read(&out).unwrap();
+    let mut again = fx.app();
+    again.select_file("fb.csv.gz");
+    key(&mut again, KeyCode::Enter);
+    keys(&mut again, "rc");
+    for _ in Variant::ALL {
+        key(&mut again, KeyCode::Left);
+    }
+    while Variant::ALL[again.compare_col] != v {
+        key(&mut again, KeyCode::Right);
+    }
+    key(&mut again, KeyCode::Char(' '));
+    assert_eq!(again.open_entry().unwrap().variant_status(v), "chosen");
+    let asks = update(&mut again, Msg::Key(KeyEvent::from(KeyCode::Char('w'))));
+    assert!(asks.is_empty(), "nothing written before the answer");
+    assert_eq!(again.open_entry().unwrap().overwrite, Some(v));
+    let text = buffer_text(terminal(&again, 80, 24).backend().buffer());
+    assert!(text.contains("Overwrite?"), "{text}");
+    assert!(
+        text.contains(&format!("corrected/fb.{v}.csv.gz exists")),
+        "{text}"
+    );
+    keys(&mut again, "n");
+    assert_eq!(again.open_entry().unwrap().overwrite, None);
+    assert_eq!(std::fs::read(&out).unwrap(), written);
+    assert!(std::fs::read_to_string(&side).unwrap().contains(&other));
+    keys(&mut again, "w");
+    keys(&mut again, "y");
+    let e = again.open_entry().unwrap();
+    assert_eq!(e.overwrite, None);
+    assert_eq!(e.variant_status(v), "saved");
+    let now = crate::sidecar::Sidecar::load(&side).unwrap().limits.sha256;
+    assert_eq!(now, hash, "written with the table in use");
+    // The same correction again: nothing to ask.
+    keys(&mut again, "w");
+    assert_eq!(again.open_entry().unwrap().overwrite, None);
+    assert_eq!(again.open_entry().unwrap().variant_status(v), "saved");
+}
+
 #[test]
 fn choosing_a_variant_keeps_to_its_trial() {
     let fx = Fixture::new();
