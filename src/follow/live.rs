@@ -3,6 +3,7 @@
 use super::extrapolate::{Extrapolation, Solution};
 use super::schedule::Schedule;
 use crate::acm::RunControl;
+use crate::calibration::AppliedCalibration;
 use crate::correct::pipeline::{self, Preparation, Setup};
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
@@ -34,6 +35,12 @@ pub struct FollowerConfig {
     /// Rows later than this many seconds after the first sample are left out
     /// (`None`: none are).
     pub until_s: Option<f64>,
+    /// A functional calibration (`acmw calibrate`: a fixed rotation of each
+    /// calibrated IMU's sensor frame, `G_R_FF = G_R_SF * R^-1`) applied to
+    /// every prefix before it is solved and to every new row before its
+    /// correction, as `acmw correct --calibration` applies it to the whole
+    /// trial (`None`: rows are corrected as read).
+    pub calibration: Option<AppliedCalibration>,
 }
 
 impl FollowerConfig {
@@ -44,6 +51,15 @@ impl FollowerConfig {
             limits: &self.limits,
             limits_source: &self.limits_source,
             settings: &self.settings,
+        }
+    }
+
+    /// What is done to a prefix before it is corrected: the functional
+    /// calibration, if any (no pose calibration).
+    pub fn preparation(&self) -> Preparation {
+        Preparation {
+            calibration: self.calibration.clone(),
+            pose: None,
         }
     }
 
@@ -160,6 +176,11 @@ impl Follower {
         self.reached_until = false;
         self.asked = 0;
         self.answered = 0;
+    }
+
+    /// What it corrects with.
+    pub fn config(&self) -> &FollowerConfig {
+        &self.config
     }
 
     /// The rows read so far (`None` before the first).
@@ -354,11 +375,24 @@ impl Follower {
         }
     }
 
-    /// Samples `range` corrected with the newest solution (extrapolated past
-    /// the samples it was solved on), as a trial of those samples.
+    /// Samples `range` calibrated (when the configuration names a
+    /// functional calibration) and corrected with the newest solution
+    /// (extrapolated past the samples it was solved on), as a trial of
+    /// those samples.
     pub fn corrected(&self, range: Range<usize>) -> Option<Trial> {
         let trial = self.trial.as_ref()?;
-        Some(self.solution.apply(trial, range, trial.time_s[0]))
+        let t0 = trial.time_s[0];
+        Some(match &self.config.calibration {
+            None => self.solution.apply(trial, range, t0),
+            Some(c) => {
+                let idx: Vec<usize> = range.collect();
+                let mut rows = trial.select(&idx, &trial.name);
+                // IMUs the calibration names but the trial lacks: the final
+                // correction reports them.
+                let _ = c.apply(&mut rows, &self.config.model);
+                self.solution.apply(&rows, 0..rows.len(), t0)
+            }
+        })
     }
 
     /// Stops the background solver (a solve under way stops at its next window).
@@ -413,6 +447,7 @@ fn solver(
     outbox: &mpsc::Sender<Answer>,
     cancel: &AtomicBool,
 ) {
+    let preparation = config.preparation();
     while let Ok(mut req) = inbox.recv() {
         while let Ok(newer) = inbox.try_recv() {
             req = newer;
@@ -427,7 +462,7 @@ fn solver(
             cancel: Some(cancel),
             progress: None,
         };
-        let result = pipeline::prepare(req.trial, setup, &Preparation::default())
+        let result = pipeline::prepare(req.trial, setup, &preparation)
             .map_err(|e| e.to_string())
             .and_then(|p| {
                 pipeline::correct(&p.trial, setup, config.variant, &control)
@@ -472,6 +507,7 @@ mod tests {
             extrapolation: Extrapolation::default(),
             warmup_s: 0.0,
             until_s,
+            calibration: None,
         }
     }
 

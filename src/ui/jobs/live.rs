@@ -55,6 +55,7 @@ impl LiveJob {
             extrapolation: Extrapolation::default(),
             warmup_s: WARMUP_S,
             until_s: None,
+            calibration: None,
         };
         LiveJob {
             follower: Follower::new(&job.file, config),
