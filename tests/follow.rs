@@ -329,6 +329,62 @@ fn a_functional_calibration_is_applied_live_and_in_the_final_correction() {
 }
 
 #[test]
+fn a_pose_calibration_waits_for_its_span_then_calibrates_the_rows_after() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let input = d.join("growing.csv");
+    let trial = drifting(60.0, 12);
+    let text = trial_to_string(&trial, TrialFormat::QuatCsv);
+    // The header and the first 3 s of rows land well before the span 5..6 s.
+    let cut = text.match_indices('\n').nth(150).unwrap().0 + 1;
+    let pose = ["--pose-calibration", "5..6", "--base-forward", "+x"];
+    let child = follow(d, &input, &pose);
+    write_in_fragments(&input, &text.as_bytes()[..cut], 0.3, 5);
+    std::thread::sleep(Duration::from_millis(1000));
+    write_in_fragments(&input, &text.as_bytes()[cut..], 3.0, 6);
+    let (_, stderr) = finish(child);
+    assert!(
+        stderr.contains(
+            "rows go out as read (neither calibrated nor corrected) until a row after 6 s arrives"
+        ),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("pose calibration at 5..6 s (51 samples)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("could not solve"), "{stderr}");
+    // The final correction and its sidecar are `acmw correct`'s with the same flags.
+    let (offline, offline_sidecar) = correct_with(d, &input, &pose);
+    assert!(
+        std::fs::read(d.join("final.csv")).unwrap() == offline,
+        "the final correction differs from acmw correct --pose-calibration"
+    );
+    let fin_sidecar = sidecar(&d.join("final.json"));
+    assert!(fin_sidecar["pose_calibration"].is_object(), "{fin_sidecar}");
+    assert_eq!(fin_sidecar, offline_sidecar);
+    // Every row once; the first 3 s exactly as written (before the span).
+    let written = read_trial(&input, &model()).unwrap();
+    let live = read_trial(&d.join("stream.csv"), &model()).unwrap();
+    assert_eq!(live.time_s, written.time_s);
+    let stream = std::fs::read_to_string(d.join("stream.csv")).unwrap();
+    let expect = trial_to_string(&written, TrialFormat::QuatCsv);
+    let lines = |t: &str| t.lines().take(151).map(String::from).collect::<Vec<_>>();
+    assert!(
+        lines(&stream) == lines(&expect),
+        "the rows before the pose span are not as written"
+    );
+    // The last row is calibrated: its base IMU (which the ACM leaves alone)
+    // is the final correction's, heading and offset applied, not the raw one.
+    let fin = read_trial(&d.join("final.csv"), &model()).unwrap();
+    let last = live.len() - 1;
+    let base = |t: &Trial| t.imu("base").unwrap().orientation[last];
+    let to_final = angle_between_deg(&base(&live), &base(&fin));
+    assert!(to_final < 1e-4, "live base {to_final} deg from the final");
+    assert!(angle_between_deg(&base(&written), &base(&fin)) > 1.0);
+}
+
+#[test]
 fn truncation_is_noticed_and_an_euler_trial_followed_from_its_start() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("growing.csv");

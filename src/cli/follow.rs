@@ -2,7 +2,9 @@
 //! A thin layer over `acm_workbench::follow` (reading, schedule,
 //! extrapolation, background solves) and the pipeline (the final correction).
 
-use super::common::{load_calibration, load_context, load_prepared, variant_parser, EngineArgs};
+use super::common::{
+    load_calibration, load_context, load_prepared, variant_parser, EngineArgs, PoseArgs,
+};
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation, Source};
 use acm_workbench::follow::{
@@ -71,6 +73,11 @@ pub struct FollowArgs {
     pub calibration: Option<PathBuf>,
     #[command(flatten)]
     pub engine: EngineArgs,
+    /// Pose calibration: rows go out as read, and nothing is solved, until
+    /// a row later than its time or span arrives; then it is found on the
+    /// rows so far and applied to every later row and solve.
+    #[command(flatten)]
+    pub pose: PoseArgs,
     /// No messages on standard error but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -279,6 +286,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         warmup_s: args.warmup,
         until_s: args.until,
         calibration,
+        pose: args.pose.calibration(&ctx.model),
     };
     let s = &ctx.settings;
     if !args.quiet {
@@ -303,6 +311,13 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
                 c.imus.len()
             );
         }
+        if let Some(p) = &config.pose {
+            eprintln!(
+                "pose calibration at {} s: rows go out as read (neither calibrated nor corrected) until a row after {} s arrives",
+                p.at,
+                p.at.end_s()
+            );
+        }
     }
     let mut reading = if input.is_dir() {
         Reading::Exports(Box::new(ExportsTail::new(input, &config.model)))
@@ -315,6 +330,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     let _watcher = watch(input, wake_tx, args.quiet);
     let mut format: Option<TrialFormat> = args.format;
     let mut last_growth = Instant::now();
+    let mut pose_said = false;
     let end = loop {
         if stop.load(Ordering::Relaxed) {
             break End::Interrupted;
@@ -325,6 +341,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
             Got::Restarted(reason) => {
                 eprintln!("{name} {reason}: starting over");
                 follower.restart();
+                pose_said = false;
                 sink.restart()?;
                 format = args.format;
             }
@@ -341,6 +358,17 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         }
         if reading.offset() != before {
             last_growth = Instant::now();
+        }
+        if let (Some(found), false) = (follower.pose(), pose_said) {
+            pose_said = true;
+            match found {
+                Ok(p) if !args.quiet => eprintln!(
+                    "pose calibration at {} s ({} samples), heading correction {:.2} deg: later rows are calibrated and corrected",
+                    p.calibration.at, p.samples, p.heading_deg
+                ),
+                Ok(_) => {}
+                Err(e) => eprintln!("{name}: {e}; rows go on as read"),
+            }
         }
         for solved in follower.poll_solved() {
             if args.quiet {

@@ -7,6 +7,7 @@ use crate::calibration::AppliedCalibration;
 use crate::correct::pipeline::{self, Preparation, Setup};
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
+use crate::pose::{PoseCalibration, PoseRecord};
 use crate::trial::{
     csv_format_of_header, read_rows_from_str, ImuSeries, Trial, TrialError, TrialFormat,
 };
@@ -41,6 +42,11 @@ pub struct FollowerConfig {
     /// correction, as `acmw correct --calibration` applies it to the whole
     /// trial (`None`: rows are corrected as read).
     pub calibration: Option<AppliedCalibration>,
+    /// A pose calibration with heading correction, applied after the
+    /// functional one: nothing is solved, and rows go out as read, until a
+    /// row later than its time or span arrives; then it is found on the rows
+    /// so far, and applied to every prefix solved and every later row.
+    pub pose: Option<PoseCalibration>,
 }
 
 impl FollowerConfig {
@@ -55,11 +61,11 @@ impl FollowerConfig {
     }
 
     /// What is done to a prefix before it is corrected: the functional
-    /// calibration, if any (no pose calibration).
+    /// calibration, then the pose calibration, if any.
     pub fn preparation(&self) -> Preparation {
         Preparation {
             calibration: self.calibration.clone(),
-            pose: None,
+            pose: self.pose,
         }
     }
 
@@ -117,6 +123,9 @@ pub struct Follower {
     solved_trial: Option<Arc<Trial>>,
     generation: u64,
     reached_until: bool,
+    /// The pose calibration found once its samples were all read (or why it
+    /// could not be found).
+    pose: Option<Result<PoseRecord, String>>,
     /// Samples of the newest solve asked for, and of the newest answered, in
     /// this generation.
     asked: usize,
@@ -154,6 +163,7 @@ impl Follower {
             solved_trial: None,
             generation: 0,
             reached_until: false,
+            pose: None,
             asked: 0,
             answered: 0,
             requests: Some(requests),
@@ -174,6 +184,7 @@ impl Follower {
         self.solved_trial = None;
         self.generation += 1;
         self.reached_until = false;
+        self.pose = None;
         self.asked = 0;
         self.answered = 0;
     }
@@ -298,13 +309,49 @@ impl Follower {
         }
         let after = self.trial.as_ref().map_or(0, Trial::len);
         if after > before {
+            self.find_pose();
             self.schedule_solve();
         }
         Ok(before..after)
     }
 
+    /// The pose calibration, once a row later than its time or span was
+    /// read (`None` before; an error when it cannot be done).
+    pub fn pose(&self) -> Option<&Result<PoseRecord, String>> {
+        self.pose.as_ref()
+    }
+
+    /// Whether rows are still waiting for the pose calibration's samples
+    /// (they go out as read, and nothing is solved).
+    pub fn awaiting_pose(&self) -> bool {
+        self.config.pose.is_some() && !matches!(self.pose, Some(Ok(_)))
+    }
+
+    /// Finds the pose calibration on the rows so far once its samples are in.
+    fn find_pose(&mut self) {
+        let (Some(p), None, Some(trial)) = (&self.config.pose, &self.pose, &self.trial) else {
+            return;
+        };
+        let t0 = trial.time_s[0];
+        if trial.time_s[trial.len() - 1] - t0 <= p.at.end_s() + EPS {
+            return;
+        }
+        let mut rows = trial.clone();
+        if let Some(c) = &self.config.calibration {
+            let _ = c.apply(&mut rows, &self.config.model);
+        }
+        self.pose = Some(
+            crate::pose::calibrate(&rows, &self.config.model, p)
+                .map(|(_, r)| r)
+                .map_err(|e| e.to_string()),
+        );
+    }
+
     /// Sends the newest prefix due to the solver, when a solve point was passed.
     fn schedule_solve(&mut self) {
+        if self.awaiting_pose() {
+            return;
+        }
         let Some(trial) = &self.trial else { return };
         let t0 = trial.time_s[0];
         let elapsed = trial.time_s[trial.len() - 1] - t0;
@@ -317,6 +364,14 @@ impl Follower {
         }
         self.next_point = k + 1;
         let point_s = schedule.point(k);
+        // A prefix solved must hold the pose calibration's samples, all of them.
+        if self
+            .config
+            .pose
+            .is_some_and(|p| point_s <= p.at.end_s() + EPS)
+        {
+            return;
+        }
         let n = trial.time_s.partition_point(|&t| t - t0 < point_s - EPS);
         if n < 2 {
             return;
@@ -382,14 +437,24 @@ impl Follower {
     pub fn corrected(&self, range: Range<usize>) -> Option<Trial> {
         let trial = self.trial.as_ref()?;
         let t0 = trial.time_s[0];
-        Some(match &self.config.calibration {
-            None => self.solution.apply(trial, range, t0),
-            Some(c) => {
-                let idx: Vec<usize> = range.collect();
+        let idx: Vec<usize> = range.clone().collect();
+        if self.awaiting_pose() {
+            let mut rows = trial.select(&idx, &trial.name);
+            rows.warnings.clear();
+            return Some(rows);
+        }
+        Some(match (&self.config.calibration, &self.pose) {
+            (None, None) => self.solution.apply(trial, range, t0),
+            (calibration, pose) => {
                 let mut rows = trial.select(&idx, &trial.name);
                 // IMUs the calibration names but the trial lacks: the final
                 // correction reports them.
-                let _ = c.apply(&mut rows, &self.config.model);
+                if let Some(c) = calibration {
+                    let _ = c.apply(&mut rows, &self.config.model);
+                }
+                if let Some(Ok(p)) = pose {
+                    p.apply(&mut rows);
+                }
                 self.solution.apply(&rows, 0..rows.len(), t0)
             }
         })
@@ -508,6 +573,7 @@ mod tests {
             warmup_s: 0.0,
             until_s,
             calibration: None,
+            pose: None,
         }
     }
 

@@ -56,6 +56,7 @@ impl LiveJob {
             warmup_s: WARMUP_S,
             until_s: None,
             calibration: None,
+            pose: None,
         };
         LiveJob {
             follower: Follower::new(&job.file, config),
