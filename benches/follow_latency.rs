@@ -204,6 +204,8 @@ fn rms_table(trial: &Trial) {
                 extrapolation: how,
                 warmup_s: 10.0,
                 until_s: None,
+                calibration: None,
+                pose: None,
             },
         );
         // Samples from the first window's end on (what is left once warmed up).

@@ -114,6 +114,44 @@ pub struct PoseRecord {
     pub offsets: Vec<ImuOffset>,
 }
 
+impl PoseTime {
+    /// The last time of the calibration, seconds from the first sample: once
+    /// a sample later than it was read, the calibration's samples are all in.
+    pub fn end_s(self) -> f64 {
+        match self {
+            PoseTime::At(t) => t,
+            PoseTime::Span(_, b) => b,
+        }
+    }
+}
+
+impl PoseRecord {
+    /// Applies what this calibration found to more samples, as [`calibrate`]
+    /// applied it to the trial it was found on: every orientation turned by
+    /// the heading correction about global +Z (`G_R' = Rz(psi) G_R`), and the
+    /// IMUs with an offset turned into their segment's frame (`G_R' G_R'
+    /// O_i^-1`, gyroscope readings `w' = O_i w`, rad/s).
+    pub fn apply(&self, trial: &mut Trial) {
+        let h = quat_axis_angle_deg([0.0, 0.0, 1.0], self.heading_deg);
+        for series in &mut trial.imus {
+            let offset_inv = self.offsets.iter().find(|o| o.imu == series.name).map(|o| {
+                let [w, x, y, z] = o.offset;
+                Quat::new_normalize(Quaternion::new(w, x, y, z)).inverse()
+            });
+            for q in &mut series.orientation {
+                let g = h * *q;
+                *q = match offset_inv {
+                    Some(oi) => Quat::new_normalize((g * oi).into_inner()),
+                    None => g,
+                };
+            }
+            if let Some(oi) = offset_inv {
+                series.turn_gyro(&oi);
+            }
+        }
+    }
+}
+
 /// Why a pose calibration cannot be done.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("pose calibration: {0}")]

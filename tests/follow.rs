@@ -6,6 +6,7 @@
 //! half-written would show a cut number), and a truncated file must be
 //! noticed and followed from its new start.
 
+use acm_workbench::rotation::{angle_between_deg, Quat};
 use acm_workbench::simulate::{simulate, HeadingDrift, SimConfig};
 use acm_workbench::trial::{read_trial, trial_to_string, Trial, TrialFormat};
 use rand::{Rng, SeedableRng};
@@ -98,12 +99,18 @@ fn finish(child: Child) -> (String, String) {
 
 /// `acmw correct` of `input` with the settings the follower used.
 fn correct(dir: &Path, input: &Path) -> (Vec<u8>, serde_json::Value) {
+    correct_with(dir, input, &[])
+}
+
+/// `acmw correct` of `input` with the settings the follower used and `extra`.
+fn correct_with(dir: &Path, input: &Path, extra: &[&str]) -> (Vec<u8>, serde_json::Value) {
     let out = acmw()
         .current_dir(dir)
         .arg("correct")
         .arg(input)
         .args(["-o", "offline.csv", "--sidecar", "offline.json", "-q"])
         .args(["--window", "30", "--hop", "15"])
+        .args(extra)
         .output()
         .unwrap();
     assert!(
@@ -192,6 +199,189 @@ fn final_output_equals_correct_and_the_stream_has_every_row_whole() {
         ) > 1.0,
         "the last live row was not corrected"
     );
+}
+
+#[test]
+fn a_functional_calibration_is_applied_live_and_in_the_final_correction() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A calibration made as a lab makes it: a simulated calibration
+    // session, solved by `acmw calibrate`.
+    for args in [
+        &[
+            "simulate",
+            "calibration",
+            "--seed",
+            "3",
+            "-o",
+            "c.calib.csv",
+        ][..],
+        &["calibrate", "c.calib.csv", "--quiet"][..],
+    ] {
+        let out = acmw().current_dir(d).args(args).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let cal = "c.calibration.toml";
+    assert!(d.join(cal).exists());
+    // The trial's calibrated IMUs are mounted as the session's truth says:
+    // `G_R_sensor = G_R_segment * R` (what the calibration undoes).
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("c.calib.truth.json")).unwrap())
+            .unwrap();
+    let aligned = drifting(75.0, 11);
+    let mut trial = aligned.clone();
+    let calibrated_imus = [
+        "upper_back",
+        "l_upper_arm",
+        "r_upper_arm",
+        "l_forearm",
+        "r_forearm",
+    ];
+    for imu in calibrated_imus {
+        let q: Vec<f64> = truth["rotations"][imu]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let r = Quat::new_normalize(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]));
+        for o in &mut trial.imu_mut(imu).unwrap().orientation {
+            *o *= r;
+        }
+    }
+    let input = d.join("growing.csv");
+    let text = trial_to_string(&trial, TrialFormat::QuatCsv);
+    let child = follow(d, &input, &["--calibration", cal]);
+    write_in_fragments(&input, text.as_bytes(), 4.0, 4);
+    let (_, stderr) = finish(child);
+    assert!(
+        stderr.contains("calibration c.calibration.toml (5 IMUs) applied to every row first"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("solved 0-"), "{stderr}");
+    // The final correction and its sidecar are `acmw correct --calibration`'s.
+    let (offline, offline_sidecar) = correct_with(d, &input, &["--calibration", cal]);
+    assert!(
+        std::fs::read(d.join("final.csv")).unwrap() == offline,
+        "the final correction differs from acmw correct --calibration"
+    );
+    let fin_sidecar = sidecar(&d.join("final.json"));
+    assert_eq!(fin_sidecar["calibration"]["file"], cal);
+    assert_eq!(fin_sidecar, offline_sidecar);
+    // ... and not the uncalibrated correction.
+    let (uncalibrated, _) = correct(d, &input);
+    assert!(uncalibrated != offline);
+    // Every row streamed once; the base IMU (not calibrated) as written.
+    let written = read_trial(&input, &model()).unwrap();
+    check_stream(&d.join("stream.csv"), &written, TrialFormat::QuatCsv);
+    // The first batch goes out before any solve can answer: calibrated, not
+    // corrected, so its first row is that of the calibrated trial `acmw
+    // correct --variant none --calibration` writes, to the last digit.
+    correct_with(d, &input, &["--calibration", cal, "--variant", "none"]);
+    let first_row = |path: &Path| {
+        std::fs::read_to_string(path)
+            .unwrap()
+            .lines()
+            .nth(1)
+            .unwrap()
+            .to_string()
+    };
+    let calibrated = first_row(&d.join("offline.csv"));
+    assert_eq!(first_row(&d.join("stream.csv")), calibrated);
+    assert_ne!(
+        first_row(&input),
+        calibrated,
+        "the calibration turned nothing"
+    );
+    // The calibration undoes the mounting: the live first row's calibrated
+    // IMUs are within 3 deg of the aligned sensors (`acmw calibrate` finds
+    // the rotations to under 2 deg on this session).
+    let live = read_trial(&d.join("stream.csv"), &model()).unwrap();
+    for imu in calibrated_imus {
+        let err = angle_between_deg(
+            &live.imu(imu).unwrap().orientation[0],
+            &aligned.imu(imu).unwrap().orientation[0],
+        );
+        assert!(
+            err < 3.0,
+            "{imu}: calibrated {err} deg from the aligned sensor"
+        );
+    }
+    // Past the first solve the calibrated IMUs are corrected too, in the
+    // calibrated frame: the last live row is nearer the final correction's
+    // last row than the calibrated input's.
+    let fin = read_trial(&d.join("final.csv"), &model()).unwrap();
+    let none = read_trial(&d.join("offline.csv"), &model()).unwrap();
+    let last = live.len() - 1;
+    let q = |t: &Trial| t.imu("r_upper_arm").unwrap().orientation[last];
+    let (to_final, raw_to_final) = (
+        angle_between_deg(&q(&live), &q(&fin)),
+        angle_between_deg(&q(&none), &q(&fin)),
+    );
+    assert!(
+        to_final < raw_to_final,
+        "r_upper_arm: live {to_final} deg from the final, the calibrated input {raw_to_final}"
+    );
+}
+
+#[test]
+fn a_pose_calibration_waits_for_its_span_then_calibrates_the_rows_after() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let input = d.join("growing.csv");
+    let trial = drifting(60.0, 12);
+    let text = trial_to_string(&trial, TrialFormat::QuatCsv);
+    // The header and the first 3 s of rows land well before the span 5..6 s.
+    let cut = text.match_indices('\n').nth(150).unwrap().0 + 1;
+    let pose = ["--pose-calibration", "5..6", "--base-forward", "+x"];
+    let child = follow(d, &input, &pose);
+    write_in_fragments(&input, &text.as_bytes()[..cut], 0.3, 5);
+    std::thread::sleep(Duration::from_millis(1000));
+    write_in_fragments(&input, &text.as_bytes()[cut..], 3.0, 6);
+    let (_, stderr) = finish(child);
+    assert!(
+        stderr.contains(
+            "rows go out as read (neither calibrated nor corrected) until a row after 6 s arrives"
+        ),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("pose calibration at 5..6 s (51 samples)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("could not solve"), "{stderr}");
+    // The final correction and its sidecar are `acmw correct`'s with the same flags.
+    let (offline, offline_sidecar) = correct_with(d, &input, &pose);
+    assert!(
+        std::fs::read(d.join("final.csv")).unwrap() == offline,
+        "the final correction differs from acmw correct --pose-calibration"
+    );
+    let fin_sidecar = sidecar(&d.join("final.json"));
+    assert!(fin_sidecar["pose_calibration"].is_object(), "{fin_sidecar}");
+    assert_eq!(fin_sidecar, offline_sidecar);
+    // Every row once; the first 3 s exactly as written (before the span).
+    let written = read_trial(&input, &model()).unwrap();
+    let live = read_trial(&d.join("stream.csv"), &model()).unwrap();
+    assert_eq!(live.time_s, written.time_s);
+    let stream = std::fs::read_to_string(d.join("stream.csv")).unwrap();
+    let expect = trial_to_string(&written, TrialFormat::QuatCsv);
+    let lines = |t: &str| t.lines().take(151).map(String::from).collect::<Vec<_>>();
+    assert!(
+        lines(&stream) == lines(&expect),
+        "the rows before the pose span are not as written"
+    );
+    // The last row is calibrated: its base IMU (which the ACM leaves alone)
+    // is the final correction's, heading and offset applied, not the raw one.
+    let fin = read_trial(&d.join("final.csv"), &model()).unwrap();
+    let last = live.len() - 1;
+    let base = |t: &Trial| t.imu("base").unwrap().orientation[last];
+    let to_final = angle_between_deg(&base(&live), &base(&fin));
+    assert!(to_final < 1e-4, "live base {to_final} deg from the final");
+    assert!(angle_between_deg(&base(&written), &base(&fin)) > 1.0);
 }
 
 #[test]

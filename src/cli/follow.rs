@@ -2,7 +2,9 @@
 //! A thin layer over `acm_workbench::follow` (reading, schedule,
 //! extrapolation, background solves) and the pipeline (the final correction).
 
-use super::common::{load_context, load_prepared, variant_parser, EngineArgs};
+use super::common::{
+    load_calibration, load_context, load_prepared, variant_parser, EngineArgs, PoseArgs,
+};
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation, Source};
 use acm_workbench::follow::{
@@ -64,8 +66,18 @@ pub struct FollowArgs {
     /// wake it sooner where the file system delivers them).
     #[arg(long, value_name = "SECONDS", default_value = "0.2", value_parser = parse_seconds)]
     pub poll: f64,
+    /// Apply this functional calibration (`acmw calibrate`) to every row
+    /// first, live and in the final correction, as `acmw correct
+    /// --calibration` applies it.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
     #[command(flatten)]
     pub engine: EngineArgs,
+    /// Pose calibration: rows go out as read, and nothing is solved, until
+    /// a row later than its time or span arrives; then it is found on the
+    /// rows so far and applied to every later row and solve.
+    #[command(flatten)]
+    pub pose: PoseArgs,
     /// No messages on standard error but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -248,6 +260,8 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     if args.format.is_some_and(|f| !is_stream_format(f)) {
         anyhow::bail!("--format: acmw follow writes quat-csv or euler-csv");
     }
+    // A bad calibration file is reported before waiting for the trial.
+    let calibration = load_calibration(args.calibration.as_deref())?;
     let stop = Arc::new(AtomicBool::new(false));
     for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
         signal_hook::flag::register(sig, Arc::clone(&stop))?;
@@ -271,6 +285,8 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         extrapolation: args.extrapolate,
         warmup_s: args.warmup,
         until_s: args.until,
+        calibration,
+        pose: args.pose.calibration(&ctx.model),
     };
     let s = &ctx.settings;
     if !args.quiet {
@@ -288,6 +304,20 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
             s.hop_s,
             acm_workbench::names::Named::name(args.extrapolate)
         );
+        if let Some(c) = &config.calibration {
+            eprintln!(
+                "calibration {} ({} IMUs) applied to every row first",
+                c.file,
+                c.imus.len()
+            );
+        }
+        if let Some(p) = &config.pose {
+            eprintln!(
+                "pose calibration at {} s: rows go out as read (neither calibrated nor corrected) until a row after {} s arrives",
+                p.at,
+                p.at.end_s()
+            );
+        }
     }
     let mut reading = if input.is_dir() {
         Reading::Exports(Box::new(ExportsTail::new(input, &config.model)))
@@ -300,6 +330,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     let _watcher = watch(input, wake_tx, args.quiet);
     let mut format: Option<TrialFormat> = args.format;
     let mut last_growth = Instant::now();
+    let mut pose_said = false;
     let end = loop {
         if stop.load(Ordering::Relaxed) {
             break End::Interrupted;
@@ -310,6 +341,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
             Got::Restarted(reason) => {
                 eprintln!("{name} {reason}: starting over");
                 follower.restart();
+                pose_said = false;
                 sink.restart()?;
                 format = args.format;
             }
@@ -326,6 +358,17 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         }
         if reading.offset() != before {
             last_growth = Instant::now();
+        }
+        if let (Some(found), false) = (follower.pose(), pose_said) {
+            pose_said = true;
+            match found {
+                Ok(p) if !args.quiet => eprintln!(
+                    "pose calibration at {} s ({} samples), heading correction {:.2} deg: later rows are calibrated and corrected",
+                    p.calibration.at, p.samples, p.heading_deg
+                ),
+                Ok(_) => {}
+                Err(e) => eprintln!("{name}: {e}; rows go on as read"),
+            }
         }
         for solved in follower.poll_solved() {
             if args.quiet {
@@ -371,7 +414,15 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         };
         eprintln!("{name}: {why}; writing the final correction");
     }
-    final_correction(&args, &ctx, &follower, &reading, end == End::Until)
+    let preparation = follower.config().preparation();
+    final_correction(
+        &args,
+        &ctx,
+        &preparation,
+        &follower,
+        &reading,
+        end == End::Until,
+    )
 }
 
 /// Watches the input's folder (or the folder of exports) for changes (each wakes the loop); `None` when
@@ -412,6 +463,7 @@ fn watch(
 fn final_correction(
     args: &FollowArgs,
     ctx: &super::common::Context,
+    preparation: &Preparation,
     follower: &Follower,
     reading: &Reading,
     cut: bool,
@@ -420,7 +472,7 @@ fn final_correction(
     let whole = !cut && reading.read_whole(input);
     let (source, prepared) = if whole {
         let file = pipeline::read(input)?;
-        load_prepared(ctx, &file, &Preparation::default(), false, args.quiet)?
+        load_prepared(ctx, &file, preparation, false, args.quiet)?
     } else {
         let trial = follower
             .trial()
@@ -441,8 +493,13 @@ fn final_correction(
         }
         // The whole file as it is now, for its format and the sidecar's hash.
         let source = Source::of(&pipeline::read(input)?);
-        let prepared = pipeline::prepare(trial, ctx.setup(), &Preparation::default())
+        let prepared = pipeline::prepare(trial, ctx.setup(), preparation)
             .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+        if !args.quiet {
+            for w in &prepared.calibration_warnings {
+                eprintln!("warning: {w}");
+            }
+        }
         (source, prepared)
     };
     let trial = &prepared.trial;

@@ -3,9 +3,11 @@
 use super::extrapolate::{Extrapolation, Solution};
 use super::schedule::Schedule;
 use crate::acm::RunControl;
+use crate::calibration::AppliedCalibration;
 use crate::correct::pipeline::{self, Preparation, Setup};
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
+use crate::pose::{PoseCalibration, PoseRecord};
 use crate::trial::{
     csv_format_of_header, read_rows_from_str, ImuSeries, Trial, TrialError, TrialFormat,
 };
@@ -34,6 +36,17 @@ pub struct FollowerConfig {
     /// Rows later than this many seconds after the first sample are left out
     /// (`None`: none are).
     pub until_s: Option<f64>,
+    /// A functional calibration (`acmw calibrate`: a fixed rotation of each
+    /// calibrated IMU's sensor frame, `G_R_FF = G_R_SF * R^-1`) applied to
+    /// every prefix before it is solved and to every new row before its
+    /// correction, as `acmw correct --calibration` applies it to the whole
+    /// trial (`None`: rows are corrected as read).
+    pub calibration: Option<AppliedCalibration>,
+    /// A pose calibration with heading correction, applied after the
+    /// functional one: nothing is solved, and rows go out as read, until a
+    /// row later than its time or span arrives; then it is found on the rows
+    /// so far, and applied to every prefix solved and every later row.
+    pub pose: Option<PoseCalibration>,
 }
 
 impl FollowerConfig {
@@ -44,6 +57,15 @@ impl FollowerConfig {
             limits: &self.limits,
             limits_source: &self.limits_source,
             settings: &self.settings,
+        }
+    }
+
+    /// What is done to a prefix before it is corrected: the functional
+    /// calibration, then the pose calibration, if any.
+    pub fn preparation(&self) -> Preparation {
+        Preparation {
+            calibration: self.calibration.clone(),
+            pose: self.pose,
         }
     }
 
@@ -101,6 +123,9 @@ pub struct Follower {
     solved_trial: Option<Arc<Trial>>,
     generation: u64,
     reached_until: bool,
+    /// The pose calibration found once its samples were all read (or why it
+    /// could not be found).
+    pose: Option<Result<PoseRecord, String>>,
     /// Samples of the newest solve asked for, and of the newest answered, in
     /// this generation.
     asked: usize,
@@ -138,6 +163,7 @@ impl Follower {
             solved_trial: None,
             generation: 0,
             reached_until: false,
+            pose: None,
             asked: 0,
             answered: 0,
             requests: Some(requests),
@@ -158,8 +184,14 @@ impl Follower {
         self.solved_trial = None;
         self.generation += 1;
         self.reached_until = false;
+        self.pose = None;
         self.asked = 0;
         self.answered = 0;
+    }
+
+    /// What it corrects with.
+    pub fn config(&self) -> &FollowerConfig {
+        &self.config
     }
 
     /// The rows read so far (`None` before the first).
@@ -277,13 +309,49 @@ impl Follower {
         }
         let after = self.trial.as_ref().map_or(0, Trial::len);
         if after > before {
+            self.find_pose();
             self.schedule_solve();
         }
         Ok(before..after)
     }
 
+    /// The pose calibration, once a row later than its time or span was
+    /// read (`None` before; an error when it cannot be done).
+    pub fn pose(&self) -> Option<&Result<PoseRecord, String>> {
+        self.pose.as_ref()
+    }
+
+    /// Whether rows are still waiting for the pose calibration's samples
+    /// (they go out as read, and nothing is solved).
+    pub fn awaiting_pose(&self) -> bool {
+        self.config.pose.is_some() && !matches!(self.pose, Some(Ok(_)))
+    }
+
+    /// Finds the pose calibration on the rows so far once its samples are in.
+    fn find_pose(&mut self) {
+        let (Some(p), None, Some(trial)) = (&self.config.pose, &self.pose, &self.trial) else {
+            return;
+        };
+        let t0 = trial.time_s[0];
+        if trial.time_s[trial.len() - 1] - t0 <= p.at.end_s() + EPS {
+            return;
+        }
+        let mut rows = trial.clone();
+        if let Some(c) = &self.config.calibration {
+            let _ = c.apply(&mut rows, &self.config.model);
+        }
+        self.pose = Some(
+            crate::pose::calibrate(&rows, &self.config.model, p)
+                .map(|(_, r)| r)
+                .map_err(|e| e.to_string()),
+        );
+    }
+
     /// Sends the newest prefix due to the solver, when a solve point was passed.
     fn schedule_solve(&mut self) {
+        if self.awaiting_pose() {
+            return;
+        }
         let Some(trial) = &self.trial else { return };
         let t0 = trial.time_s[0];
         let elapsed = trial.time_s[trial.len() - 1] - t0;
@@ -296,6 +364,14 @@ impl Follower {
         }
         self.next_point = k + 1;
         let point_s = schedule.point(k);
+        // A prefix solved must hold the pose calibration's samples, all of them.
+        if self
+            .config
+            .pose
+            .is_some_and(|p| point_s <= p.at.end_s() + EPS)
+        {
+            return;
+        }
         let n = trial.time_s.partition_point(|&t| t - t0 < point_s - EPS);
         if n < 2 {
             return;
@@ -354,11 +430,34 @@ impl Follower {
         }
     }
 
-    /// Samples `range` corrected with the newest solution (extrapolated past
-    /// the samples it was solved on), as a trial of those samples.
+    /// Samples `range` calibrated (when the configuration names a
+    /// functional calibration) and corrected with the newest solution
+    /// (extrapolated past the samples it was solved on), as a trial of
+    /// those samples.
     pub fn corrected(&self, range: Range<usize>) -> Option<Trial> {
         let trial = self.trial.as_ref()?;
-        Some(self.solution.apply(trial, range, trial.time_s[0]))
+        let t0 = trial.time_s[0];
+        let idx: Vec<usize> = range.clone().collect();
+        if self.awaiting_pose() {
+            let mut rows = trial.select(&idx, &trial.name);
+            rows.warnings.clear();
+            return Some(rows);
+        }
+        Some(match (&self.config.calibration, &self.pose) {
+            (None, None) => self.solution.apply(trial, range, t0),
+            (calibration, pose) => {
+                let mut rows = trial.select(&idx, &trial.name);
+                // IMUs the calibration names but the trial lacks: the final
+                // correction reports them.
+                if let Some(c) = calibration {
+                    let _ = c.apply(&mut rows, &self.config.model);
+                }
+                if let Some(Ok(p)) = pose {
+                    p.apply(&mut rows);
+                }
+                self.solution.apply(&rows, 0..rows.len(), t0)
+            }
+        })
     }
 
     /// Stops the background solver (a solve under way stops at its next window).
@@ -413,6 +512,7 @@ fn solver(
     outbox: &mpsc::Sender<Answer>,
     cancel: &AtomicBool,
 ) {
+    let preparation = config.preparation();
     while let Ok(mut req) = inbox.recv() {
         while let Ok(newer) = inbox.try_recv() {
             req = newer;
@@ -427,7 +527,7 @@ fn solver(
             cancel: Some(cancel),
             progress: None,
         };
-        let result = pipeline::prepare(req.trial, setup, &Preparation::default())
+        let result = pipeline::prepare(req.trial, setup, &preparation)
             .map_err(|e| e.to_string())
             .and_then(|p| {
                 pipeline::correct(&p.trial, setup, config.variant, &control)
@@ -472,6 +572,8 @@ mod tests {
             extrapolation: Extrapolation::default(),
             warmup_s: 0.0,
             until_s,
+            calibration: None,
+            pose: None,
         }
     }
 

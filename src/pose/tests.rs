@@ -244,3 +244,25 @@ fn bad_calibrations_are_explained() {
     let raw = extra.imu("wrist_watch").unwrap().orientation[9];
     assert!(angle_between_deg(&got, &(h * raw)) < 1e-9);
 }
+
+#[test]
+fn a_record_applied_to_the_trial_again_gives_the_calibrated_trial() {
+    // What `acmw follow` does with rows after the span: the record found on
+    // the trial, applied to it, turns every sample as `calibrate` did.
+    let model = Model::infant13();
+    let trial = turned(&short_trial(), 40.0);
+    let (calibrated, record) = calibrate(&trial, &model, &cal("1..2")).unwrap();
+    assert!(record.heading_deg.abs() > 10.0, "{}", record.heading_deg);
+    let mut again = trial.clone();
+    record.apply(&mut again);
+    let mut worst = 0.0f64;
+    for (a, b) in again.imus.iter().zip(&calibrated.imus) {
+        assert_eq!(a.name, b.name);
+        for (p, q) in a.orientation.iter().zip(&b.orientation) {
+            worst = worst.max(angle_between_deg(p, q));
+        }
+    }
+    assert!(worst < 1e-9, "{worst} deg");
+    // ... and not the trial as read.
+    assert!(angle_between_deg(&trial.imus[0].orientation[0], &again.imus[0].orientation[0]) > 10.0);
+}

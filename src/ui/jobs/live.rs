@@ -55,6 +55,8 @@ impl LiveJob {
             extrapolation: Extrapolation::default(),
             warmup_s: WARMUP_S,
             until_s: None,
+            calibration: None,
+            pose: None,
         };
         LiveJob {
             follower: Follower::new(&job.file, config),
