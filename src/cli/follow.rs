@@ -8,11 +8,10 @@ use super::common::{
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation, Source};
 use acm_workbench::follow::{
-    exports_ready, ExportsEvent, ExportsTail, Extrapolation, Follower, FollowerConfig, Tail,
-    TailEvent,
+    exports_ready, push, Extrapolation, Follower, FollowerConfig, LiveSource, Look,
 };
 use acm_workbench::trial::format::{is_followable, is_stream_format};
-use acm_workbench::trial::{detect_model, trial_to_string, Trial, TrialFormat};
+use acm_workbench::trial::{detect_model, trial_to_string, TrialFormat};
 use anyhow::Context as _;
 use clap::Args;
 use std::io::Write;
@@ -149,66 +148,6 @@ impl Sink {
     }
 }
 
-/// What is followed: one CSV, or a folder of Xsens exports.
-enum Reading {
-    Csv(Box<Tail>),
-    Exports(Box<ExportsTail>),
-}
-
-/// What one look found.
-enum Got {
-    Nothing,
-    Restarted(String),
-    Lines { text: String, first_line: u64 },
-    Samples(Trial),
-}
-
-impl Reading {
-    fn poll(&mut self) -> anyhow::Result<Got> {
-        Ok(match self {
-            Reading::Csv(t) => match t.poll()? {
-                TailEvent::Nothing => Got::Nothing,
-                TailEvent::Restarted { reason } => Got::Restarted(reason),
-                TailEvent::Lines { text, first_line } => Got::Lines { text, first_line },
-            },
-            Reading::Exports(x) => match x.poll()? {
-                ExportsEvent::Nothing => Got::Nothing,
-                ExportsEvent::Restarted { reason } => Got::Restarted(reason),
-                ExportsEvent::Samples(t) => Got::Samples(t),
-            },
-        })
-    }
-
-    /// Bytes read so far (over every export).
-    fn offset(&self) -> u64 {
-        match self {
-            Reading::Csv(t) => t.offset(),
-            Reading::Exports(x) => x.offset(),
-        }
-    }
-
-    /// Whether every byte on disk was read, with no unfinished line.
-    fn read_whole(&self, input: &Path) -> bool {
-        match self {
-            Reading::Csv(t) => {
-                let len = std::fs::metadata(input).map(|m| m.len()).ok();
-                !t.has_partial_line() && len == Some(t.offset())
-            }
-            Reading::Exports(x) => x.read_whole(),
-        }
-    }
-}
-
-/// Adds what a look found to the follower: the indices of the new samples.
-fn push(follower: &mut Follower, got: Got) -> anyhow::Result<std::ops::Range<usize>> {
-    let n = follower.trial().map_or(0, Trial::len);
-    Ok(match got {
-        Got::Lines { text, first_line } => follower.push(&text, first_line)?,
-        Got::Samples(batch) => follower.push_samples(batch)?,
-        Got::Nothing | Got::Restarted(_) => n..n,
-    })
-}
-
 /// Why following ended.
 #[derive(Debug, PartialEq)]
 enum End {
@@ -319,11 +258,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
             );
         }
     }
-    let mut reading = if input.is_dir() {
-        Reading::Exports(Box::new(ExportsTail::new(input, &config.model)))
-    } else {
-        Reading::Csv(Box::new(Tail::new(input)))
-    };
+    let mut reading = LiveSource::new(input, &config.model);
     let mut follower = Follower::new(&name, config);
     let mut sink = Sink::open(args.output.as_deref())?;
     let (wake_tx, wake_rx) = crossbeam_channel::unbounded::<()>();
@@ -337,8 +272,8 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         }
         let before = reading.offset();
         match reading.poll()? {
-            Got::Nothing => {}
-            Got::Restarted(reason) => {
+            Look::Nothing => {}
+            Look::Restarted(reason) => {
                 eprintln!("{name} {reason}: starting over");
                 follower.restart();
                 pose_said = false;
@@ -398,7 +333,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
     follower.stop();
     // What the writer added since the last look, up to the end.
     if end != End::Until {
-        while let got @ (Got::Lines { .. } | Got::Samples(_)) = reading.poll()? {
+        while let got @ (Look::Lines { .. } | Look::Samples(_)) = reading.poll()? {
             let range = push(&mut follower, got)?;
             if let (false, Some(batch)) = (range.is_empty(), follower.corrected(range.clone())) {
                 let fmt = format.unwrap_or(TrialFormat::QuatCsv);
@@ -465,11 +400,11 @@ fn final_correction(
     ctx: &super::common::Context,
     preparation: &Preparation,
     follower: &Follower,
-    reading: &Reading,
+    reading: &LiveSource,
     cut: bool,
 ) -> anyhow::Result<i32> {
     let input = &args.input;
-    let whole = !cut && reading.read_whole(input);
+    let whole = !cut && reading.read_whole();
     let (source, prepared) = if whole {
         let file = pipeline::read(input)?;
         load_prepared(ctx, &file, preparation, false, args.quiet)?

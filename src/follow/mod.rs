@@ -13,6 +13,7 @@
 //! * [`extrapolate`] turns the correction of the samples so far into one for
 //!   samples past its end (the last correction held, or for the heading
 //!   variants the heading drift continued at its last rate);
+//! * [`source`] puts the two behind one interface, [`LiveSource`];
 //! * [`live`] keeps the rows read, solves the prefixes in a background
 //!   thread through the one pipeline ([`crate::correct::pipeline`]) and
 //!   corrects each new row with the newest solution.
@@ -24,10 +25,12 @@ pub mod exports;
 pub mod extrapolate;
 pub mod live;
 pub mod schedule;
+pub mod source;
 pub mod tail;
 
 pub use exports::{exports_ready, ExportsEvent, ExportsTail};
 pub use extrapolate::{Extrapolation, ImuExtrapolation, Solution};
 pub use live::{Follower, FollowerConfig, Solved};
 pub use schedule::Schedule;
+pub use source::{push, LiveSource, Look};
 pub use tail::{Tail, TailEvent};

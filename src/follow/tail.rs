@@ -116,7 +116,17 @@ impl Tail {
         if !self.head.is_empty() {
             let mut now = vec![0u8; self.head.len()];
             file.seek(SeekFrom::Start(0))?;
-            file.read_exact(&mut now)?;
+            match file.read_exact(&mut now) {
+                Ok(()) => {}
+                // Cut shorter than what was read since the length was taken.
+                Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+                    return Ok(self.restart(format!(
+                        "was truncated while being read, after {} bytes were read",
+                        self.offset
+                    )));
+                }
+                Err(e) => return Err(e),
+            }
             if now != self.head {
                 return Ok(self.restart(format!(
                     "was rewritten: its first {} bytes changed",

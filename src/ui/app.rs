@@ -125,9 +125,9 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                     app.sort_trials();
                 }
             }
-            if crate::trial::format::is_followable_name(&path) {
-                // A CSV trial that changes may be growing: followed as it
-                // grows, read whole once it stops.
+            if crate::trial::format::is_followable(&path) {
+                // A CSV trial or a folder of exports that changes may be
+                // growing: followed as it grows, read whole once it stops.
                 return app.follow_effect(&file).into_iter().collect();
             }
             vec![Effect::Load {

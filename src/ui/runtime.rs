@@ -21,7 +21,7 @@ use ratatui::crossterm::terminal::{
 };
 use ratatui::crossterm::{cursor, execute};
 use ratatui::Terminal;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::io::{stdout, Write as _};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
@@ -181,15 +181,22 @@ fn changed_paths(
         .flat_map(|e| e.paths.iter())
 }
 
-/// Watches `dir` (non-recursive, debounced 250 ms) and hands each batch of
-/// content changes ([`changed_paths`]) to `on_change`; with `poll`, by reading
-/// the folder at that interval instead of through the system's notifications.
+/// Watches `dir` (with `recursive`, its sub-folders too; debounced 250 ms)
+/// and hands each batch of content changes ([`changed_paths`]) to
+/// `on_change`; with `poll`, by reading the folder at that interval instead
+/// of through the system's notifications.
 pub fn watch_folder(
     dir: &Path,
+    recursive: bool,
     poll: Option<Duration>,
     on_change: impl Fn(Vec<PathBuf>) + Send + 'static,
 ) -> Option<Watcher> {
     let debounce = Duration::from_millis(250);
+    let mode = if recursive {
+        RecursiveMode::Recursive
+    } else {
+        RecursiveMode::NonRecursive
+    };
     let handler = move |r: DebounceEventResult| {
         if let Ok(events) = r {
             let paths: Vec<PathBuf> = changed_paths(&events, poll.is_some()).cloned().collect();
@@ -201,7 +208,7 @@ pub fn watch_folder(
     match poll {
         None => {
             let mut w = new_debouncer(debounce, None, handler).ok()?;
-            w.watch(dir, RecursiveMode::NonRecursive).ok()?;
+            w.watch(dir, mode).ok()?;
             Some(Watcher::Native(w))
         }
         Some(every) => {
@@ -214,23 +221,18 @@ pub fn watch_folder(
                 config,
             )
             .ok()?;
-            w.watch(dir, RecursiveMode::NonRecursive).ok()?;
+            w.watch(dir, mode).ok()?;
             Some(Watcher::Poll(w))
         }
     }
 }
 
-/// Watches the trials folder: changed and removed trial files.
+/// Watches the trials folder: changed and removed trial files, and folders
+/// of Xsens exports whose exports change (MT Manager appending to them).
 fn watch_trials(dir: &Path, poll: Option<Duration>, tx: Sender<Event>) -> Option<Watcher> {
     let d = dir.to_path_buf();
-    watch_folder(dir, poll, move |paths| {
-        let names: BTreeSet<String> = paths
-            .iter()
-            .filter(|p| could_name_trial(p))
-            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-            .collect();
-        for name in names {
-            let path = d.join(&name);
+    watch_folder(dir, true, poll, move |paths| {
+        for (name, path) in changed_trials(&d, &paths) {
             // A deleted trial leaves the list, whatever its name says.
             let msg = if !path.exists() {
                 Msg::FileRemoved(name)
@@ -244,6 +246,39 @@ fn watch_trials(dir: &Path, poll: Option<Duration>, tx: Sender<Event>) -> Option
     })
 }
 
+/// The entries of the trials folder `dir` that changed paths touch, by name:
+/// a file in it, or a folder in it that holds a changed path deeper down
+/// when that folder is itself a trial (a folder of exports that no mapping
+/// in `dir` reads; `corrected/` and a mapping's folder are not).
+fn changed_trials(dir: &Path, paths: &[PathBuf]) -> BTreeMap<String, PathBuf> {
+    let mut listed: Option<BTreeSet<PathBuf>> = None;
+    let mut out = BTreeMap::new();
+    for p in paths {
+        let Ok(rel) = p.strip_prefix(dir) else {
+            continue;
+        };
+        let mut parts = rel.components();
+        let Some(first) = parts.next() else { continue };
+        let name = first.as_os_str().to_string_lossy().into_owned();
+        let entry = dir.join(&name);
+        let wanted = if parts.next().is_some() {
+            listed
+                .get_or_insert_with(|| {
+                    crate::trial::folder_trials(dir)
+                        .map(|v| v.into_iter().collect())
+                        .unwrap_or_default()
+                })
+                .contains(&entry)
+        } else {
+            could_name_trial(p) || p.is_dir() || !p.exists()
+        };
+        if wanted {
+            out.insert(name, entry);
+        }
+    }
+    out
+}
+
 /// Watches the limits folder: a changed table or settings file is re-read.
 fn watch_limits(
     dir: &Path,
@@ -255,7 +290,7 @@ fn watch_limits(
         return None;
     }
     let d = dir.to_path_buf();
-    watch_folder(dir, poll, move |paths| {
+    watch_folder(dir, false, poll, move |paths| {
         let relevant = paths.iter().any(|p| {
             p.file_name()
                 .is_some_and(|n| n == "settings.toml" || *n == *table.as_str())
@@ -519,7 +554,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let (tx, rx) = unbounded();
         let poll = Some(Duration::from_millis(50));
-        let _w = watch_folder(dir.path(), poll, move |paths| {
+        let _w = watch_folder(dir.path(), false, poll, move |paths| {
             let _ = tx.send(paths);
         })
         .expect("a poll watcher starts on any folder");
@@ -540,6 +575,39 @@ mod tests {
         std::thread::sleep(Duration::from_millis(1100));
         crate::save::atomic_write(&file, b"time,x\n").unwrap();
         arrives("an atomic save over it");
+    }
+
+    #[test]
+    fn a_change_inside_an_export_folder_names_that_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("a.csv"), "time\n").unwrap();
+        let walk = d.join("walk");
+        std::fs::create_dir_all(&walk).unwrap();
+        let export = walk.join("walk_00B4227C.txt");
+        std::fs::write(
+            &export,
+            "PacketCounter\tQuat_q0\tQuat_q1\tQuat_q2\tQuat_q3\n",
+        )
+        .unwrap();
+        let corrected = d.join("corrected");
+        std::fs::create_dir_all(&corrected).unwrap();
+        std::fs::write(d.join("notes.txt~"), "").unwrap();
+        let paths = [
+            d.join("a.csv"),
+            export.clone(),
+            corrected.join("a.drift.sto"),
+            d.join("gone.csv"),
+            d.join("notes.txt~"),
+        ];
+        let got = changed_trials(d, &paths);
+        let names: Vec<&str> = got.keys().map(String::as_str).collect();
+        // The file, the folder the export is in (a trial), a removed file
+        // (whatever its name); not `corrected/` (not a trial) nor an
+        // editor's backup.
+        assert_eq!(names, ["a.csv", "gone.csv", "walk"]);
+        assert_eq!(got["walk"], walk);
+        assert!(crate::trial::is_trial_path(&got["walk"]));
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //! solved up to the newest solve and extrapolated after it) and sends them
 //! to the event loop as messages.
 
-use crate::follow::{Extrapolation, Follower, FollowerConfig, Tail, TailEvent};
+use crate::follow::{push, Extrapolation, Follower, FollowerConfig, LiveSource, Look};
 use crate::metrics::trial_figures;
 use crate::model::Model;
 use crate::trial::{ImuSeries, Trial};
@@ -22,7 +22,7 @@ pub const WARMUP_S: f64 = 10.0;
 /// One follow: the reader, the follower, and the corrected samples so far.
 pub struct LiveJob {
     job: FollowJob,
-    tail: Tail,
+    source: LiveSource,
     follower: Follower,
     model: Model,
     /// The samples read so far, corrected: as solved before `solved`,
@@ -60,7 +60,7 @@ impl LiveJob {
         };
         LiveJob {
             follower: Follower::new(&job.file, config),
-            tail: Tail::new(&job.path),
+            source: LiveSource::new(&job.path, &model),
             model,
             job,
             corrected: None,
@@ -73,9 +73,9 @@ impl LiveJob {
         }
     }
 
-    /// Bytes of the file read so far.
+    /// Bytes of the file (or of every export of a folder) read so far.
     pub fn offset(&self) -> u64 {
-        self.tail.offset()
+        self.source.offset()
     }
 
     fn msg(&self, event: LiveEvent) -> Msg {
@@ -109,10 +109,10 @@ impl LiveJob {
     /// restart it noticed, if any (`Err`: the file cannot be followed, located).
     pub fn look(&mut self) -> Result<Vec<Msg>, String> {
         let mut out = vec![];
-        let before = self.tail.offset();
-        match self.tail.poll().map_err(|e| e.to_string())? {
-            TailEvent::Nothing => {}
-            TailEvent::Restarted { reason } => {
+        let before = self.source.offset();
+        match self.source.poll().map_err(|e| e.to_string())? {
+            Look::Nothing => {}
+            Look::Restarted(reason) => {
                 self.follower.restart();
                 self.corrected = None;
                 self.solved = 0;
@@ -122,11 +122,8 @@ impl LiveJob {
                 self.note = Some(why.clone());
                 out.push(self.msg(LiveEvent::Restarted(why)));
             }
-            TailEvent::Lines { text, first_line } => {
-                let range = self
-                    .follower
-                    .push(&text, first_line)
-                    .map_err(|e| e.to_string())?;
+            look => {
+                let range = push(&mut self.follower, look).map_err(|e| e.to_string())?;
                 if !range.is_empty() {
                     if let Some(batch) = self.follower.corrected(range) {
                         match &mut self.corrected {
@@ -138,7 +135,7 @@ impl LiveJob {
                 }
             }
         }
-        if self.looks > 0 && self.tail.offset() > before {
+        if self.looks > 0 && self.source.offset() > before {
             self.grew = true;
         }
         self.looks += 1;
@@ -219,12 +216,13 @@ impl LiveJob {
             model: self.model.clone(),
             // The hash of the bytes read so far: once the writer stops and
             // every byte was read, the whole file's, as its final reload
-            // (read whole) records it.
+            // (read whole) records it. An export folder's comes with that
+            // reload (nothing is saved while it grows).
             source: crate::correct::pipeline::Source {
                 path: self.job.path.clone(),
                 format,
                 gzip: false,
-                sha256: self.tail.sha256_hex(),
+                sha256: self.source.sha256_hex().unwrap_or_default(),
             },
             truth: None,
             truth_error: None,

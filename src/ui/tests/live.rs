@@ -342,3 +342,119 @@ fn a_save_waits_for_the_final_correction_and_records_the_file_hash() {
     let again = load_app("trials", &dir, &limits).unwrap();
     assert_eq!(again.entry("live.csv").unwrap().variant_status(v), "saved");
 }
+
+/// The text of one MT Manager export of `imu` (tab-separated, packet
+/// counter and quaternion; no mapping: the file name's serial is the IMU).
+fn export_text(trial: &crate::trial::Trial, imu: usize) -> String {
+    use std::fmt::Write as _;
+    let s = &trial.imus[imu];
+    let mut text =
+        String::from("// Update Rate: 50.0Hz\nPacketCounter\tQuat_q0\tQuat_q1\tQuat_q2\tQuat_q3\n");
+    for (c, q) in s.orientation.iter().enumerate() {
+        let _ = writeln!(text, "{c:05}\t{}\t{}\t{}\t{}", q.w, q.i, q.j, q.k);
+    }
+    text
+}
+
+/// A folder of Xsens exports that MT Manager appends to, one export per
+/// sensor, is followed like a growing CSV: rows shown as every sensor
+/// writes them, solved in the background, and once the writer stops the
+/// folder is read whole and corrected as `acmw correct FOLDER` corrects it.
+#[test]
+fn a_growing_export_folder_is_followed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("trials");
+    let folder = dir.join("session");
+    std::fs::create_dir_all(&folder).unwrap();
+    let mut cfg = crate::simulate::preset("knee_calf_z15").unwrap();
+    cfg.duration_s = 30.0;
+    let sim = crate::simulate::simulate(&cfg).unwrap();
+    let texts: Vec<(std::path::PathBuf, String)> = (0..sim.trial.imus.len())
+        .map(|k| {
+            let name = format!("session_{}.txt", sim.trial.imus[k].name.replace('_', "-"));
+            (folder.join(name), export_text(&sim.trial, k))
+        })
+        .collect();
+    // The lab's mapping of serials to IMUs, as OpenSense reads it.
+    let sensors: String = (sim.trial.imus.iter())
+        .map(|s| {
+            format!(
+                "<ExperimentalSensor name=\"_{}\"><name_in_model>{}</name_in_model></ExperimentalSensor>",
+                s.name.replace('_', "-"),
+                s.name
+            )
+        })
+        .collect();
+    let mapping = format!(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n<OpenSimDocument Version=\"40000\"><XsensDataReaderSettings><trial_prefix>session</trial_prefix><ExperimentalSensors>{sensors}</ExperimentalSensors></XsensDataReaderSettings></OpenSimDocument>\n"
+    );
+    std::fs::write(folder.join("myIMUMappings.xml"), mapping).unwrap();
+    // MT Manager has created the exports (headers only) when the workbench starts.
+    for (path, text) in &texts {
+        std::fs::write(path, &text[..row_at(text, 1)]).unwrap();
+    }
+    let mut app = load_app("trials", &dir, &tmp.path().join("joint_limits")).unwrap();
+    assert!(app.entry("session").is_some(), "the folder is a trial");
+    let fx = update(&mut app, Msg::FileChanged("session".into(), folder.clone()));
+    let [Effect::Follow(job)] = fx.as_slice() else {
+        panic!("{fx:?}")
+    };
+    let mut live = LiveJob::new((**job).clone());
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    // Each export grows in its own random fragments, sensors taking turns.
+    let mut at: Vec<usize> = texts.iter().map(|(_, t)| row_at(t, 1)).collect();
+    let upto = |k: usize, rows: usize| row_at(&texts[k].1, rows + 1);
+    let mut grow_to = |rows: usize, app: &mut App, live: &mut LiveJob| loop {
+        let k = rng.random_range(0..texts.len());
+        let end = upto(k, rows);
+        if at.iter().enumerate().all(|(j, &a)| a >= upto(j, rows)) {
+            break;
+        }
+        let n = rng.random_range(1..3000).min(end - at[k]);
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&texts[k].0)
+            .unwrap();
+        f.write_all(&texts[k].1.as_bytes()[at[k]..at[k] + n])
+            .unwrap();
+        at[k] += n;
+        feed(app, live.step().unwrap());
+    };
+    grow_to(600, &mut app, &mut live);
+    settle(&mut app, &mut live);
+    let e = app.entry("session").unwrap();
+    let l = e.loaded().expect("the rows every sensor wrote are shown");
+    assert_eq!(l.trial.len(), 600);
+    assert_eq!(e.variant_status(Variant::Drift), "live");
+    let v = e.live.clone().unwrap();
+    assert!(v.solved > 0 && v.solved <= 600, "{}", v.solved);
+    act(&mut app, Action::Enter);
+    let theme = Theme::builtin("dark", true).unwrap();
+    let t = buffer_text(&draw(&app, &theme, 120, 40));
+    assert!(t.contains("LIVE 600"), "{t}");
+    grow_to(sim.trial.len(), &mut app, &mut live);
+    settle(&mut app, &mut live);
+    // The writer stops: the folder is read whole and every variant corrected.
+    let fx = update(&mut app, live.finish(Ok(())));
+    assert!(matches!(fx.as_slice(), [Effect::Load { .. }]), "{fx:?}");
+    SyncRunner::run(&mut app, fx);
+    let e = app.entry("session").unwrap();
+    assert!(e.live.is_none() && e.following.is_none());
+    assert_eq!(e.results.len(), Variant::ALL.len());
+    let file = pipeline::read(&folder).unwrap();
+    let model = crate::trial::detect_model(&folder);
+    let trial = file.trial(&model).unwrap();
+    assert_eq!(e.loaded().unwrap().trial.len(), trial.len());
+    let setup = Setup {
+        model: &model,
+        limits: &app.limits.table,
+        limits_source: &app.limits.source,
+        settings: &app.settings,
+    };
+    let p = pipeline::prepare(trial, setup, &Preparation::default()).unwrap();
+    let want = pipeline::correct(&p.trial, setup, Variant::Drift, &Default::default()).unwrap();
+    assert_eq!(
+        e.results[&Variant::Drift].correction.corrected.imus,
+        want.corrected.imus
+    );
+}
