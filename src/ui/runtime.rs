@@ -253,10 +253,14 @@ fn watch_trials(dir: &Path, poll: Option<Duration>, tx: Sender<Event>) -> Option
 fn changed_trials(dir: &Path, paths: &[PathBuf]) -> BTreeMap<String, PathBuf> {
     let mut listed: Option<BTreeSet<PathBuf>> = None;
     let mut out = BTreeMap::new();
+    // The watcher may report paths under the folder's canonical path.
+    let canonical = dir.canonicalize().ok();
     for p in paths {
-        let Ok(rel) = p.strip_prefix(dir) else {
-            continue;
-        };
+        let rel = p
+            .strip_prefix(dir)
+            .ok()
+            .or_else(|| canonical.as_ref().and_then(|c| p.strip_prefix(c).ok()));
+        let Some(rel) = rel else { continue };
         let mut parts = rel.components();
         let Some(first) = parts.next() else { continue };
         let name = first.as_os_str().to_string_lossy().into_owned();
@@ -608,6 +612,15 @@ mod tests {
         assert_eq!(names, ["a.csv", "gone.csv", "walk"]);
         assert_eq!(got["walk"], walk);
         assert!(crate::trial::is_trial_path(&got["walk"]));
+        // The folder as the user named it, the paths as the system reports
+        // them (canonical): the same names.
+        let named = d.join("walk").join("..");
+        let again = changed_trials(&named, &paths);
+        assert_eq!(
+            again.keys().collect::<Vec<_>>(),
+            got.keys().collect::<Vec<_>>()
+        );
+        assert_eq!(again["walk"], named.join("walk"));
     }
 
     #[test]
