@@ -5,7 +5,10 @@
 //!    row, 50 Hz) while `acmw follow` streams to a pipe; for each row, the
 //!    time from its write returning to its corrected row being read from the
 //!    pipe (median, 99th percentile, max). `FOLLOW_LATENCY_S` seconds of the
-//!    trial (default 60), `FOLLOW_VARIANT` (default drift-centroid);
+//!    trial (default 60), `FOLLOW_VARIANT` (default drift-centroid). Twice:
+//!    into one CSV, and into a folder of 13 Xsens exports (each row written
+//!    to every export in turn; the latency runs from the last export's
+//!    write); `FOLLOW_INPUT=csv` or `exports` runs one;
 //! 2. what extrapolation costs: per variant, the RMS difference between the
 //!    live joint angles (each row corrected on arrival with the newest
 //!    solution, extrapolated) and the final offline correction's, per joint.
@@ -14,7 +17,8 @@
 //!    keeping up, as it does at real time: a 300-s solve takes well under the
 //!    10-s warm-up interval), so the figures do not depend on this machine.
 //!
-//! Run: `cargo bench --bench follow_latency` (or `bash benches/follow_latency.sh`).
+//! Run: `cargo bench --bench follow_latency` (or `bash benches/follow_latency.sh`);
+//! `FOLLOW_RMS=0` skips part 2.
 
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation, Setup};
@@ -24,7 +28,6 @@ use acm_workbench::metrics::joint_angles;
 use acm_workbench::model::Model;
 use acm_workbench::rotation::wrap180;
 use acm_workbench::trial::{read_trial, trial_to_string, Trial, TrialFormat};
-use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Write};
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -40,65 +43,111 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[i]
 }
 
-fn latency(trial: &Trial, seconds: f64, variant: &str) {
-    let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("live.csv");
+/// What the writer appends to, as a lab's recorder would.
+#[derive(Clone, Copy, PartialEq)]
+enum Input {
+    /// One canonical CSV, one write per row.
+    Csv,
+    /// A folder of MT Manager exports (tab-separated, one per IMU, with a
+    /// mapping XML), each row written to every export in turn.
+    Exports,
+}
+
+/// The files the writer appends to in `dir`: (path, header, one text per
+/// row), and the argument `acmw follow` takes.
+type Files = (Vec<(std::path::PathBuf, String, Vec<String>)>, String);
+
+fn csv_files(dir: &Path, trial: &Trial, n: usize) -> Files {
     let text = trial_to_string(trial, TrialFormat::QuatCsv);
     let mut lines = text.split_inclusive('\n');
-    let header = lines.next().unwrap();
+    let header = lines.next().unwrap().to_string();
+    let rows = lines.take(n).map(str::to_string).collect();
+    (vec![(dir.join("live.csv"), header, rows)], "live.csv".into())
+}
+
+fn export_files(dir: &Path, trial: &Trial, n: usize) -> Files {
+    let folder = dir.join("session");
+    std::fs::create_dir_all(&folder).unwrap();
+    let serial = |name: &str| name.replace('_', "-");
+    let sensors: String = (trial.imus.iter())
+        .map(|s| {
+            format!(
+                "<ExperimentalSensor name=\"_{}\"><name_in_model>{}</name_in_model></ExperimentalSensor>",
+                serial(&s.name),
+                s.name
+            )
+        })
+        .collect();
+    std::fs::write(
+        folder.join("myIMUMappings.xml"),
+        format!("<?xml version=\"1.0\" encoding=\"UTF-8\" ?>\n<OpenSimDocument Version=\"40000\"><XsensDataReaderSettings><trial_prefix>session</trial_prefix><ExperimentalSensors>{sensors}</ExperimentalSensors></XsensDataReaderSettings></OpenSimDocument>\n"),
+    )
+    .unwrap();
+    let rate = 1.0 / trial.median_dt();
+    let files = (trial.imus.iter())
+        .map(|s| {
+            let header = format!(
+                "// Update Rate: {rate:.1}Hz\nPacketCounter\tQuat_q0\tQuat_q1\tQuat_q2\tQuat_q3\n"
+            );
+            let rows = (s.orientation.iter().take(n).enumerate())
+                .map(|(c, q)| format!("{:05}\t{}\t{}\t{}\t{}\n", c % 65_536, q.w, q.i, q.j, q.k))
+                .collect();
+            (folder.join(format!("session_{}.txt", serial(&s.name))), header, rows)
+        })
+        .collect();
+    (files, "session".into())
+}
+
+fn latency(trial: &Trial, seconds: f64, variant: &str, input: Input) {
+    let dir = tempfile::tempdir().unwrap();
     let t0 = trial.time_s[0];
-    let rows: Vec<&str> = lines
-        .zip(&trial.time_s)
-        .take_while(|(_, &t)| t - t0 <= seconds)
-        .map(|(l, _)| l)
+    let n = trial.time_s.partition_point(|&t| t - t0 <= seconds);
+    let (files, arg) = match input {
+        Input::Csv => csv_files(dir.path(), trial, n),
+        Input::Exports => export_files(dir.path(), trial, n),
+    };
+    let mut handles: Vec<std::fs::File> = (files.iter())
+        .map(|(path, header, _)| {
+            let mut f = std::fs::File::create(path).unwrap();
+            f.write_all(header.as_bytes()).unwrap();
+            f.flush().unwrap();
+            f
+        })
         .collect();
-    let index: HashMap<String, usize> = rows
-        .iter()
-        .enumerate()
-        .map(|(i, l)| (l.split(',').next().unwrap().to_string(), i))
-        .collect();
-    let mut file = std::fs::File::create(&input).unwrap();
-    file.write_all(header.as_bytes()).unwrap();
-    file.flush().unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_acmw"))
         .current_dir(dir.path())
-        .args([
-            "follow",
-            "live.csv",
-            "--idle-exit",
-            "1",
-            "--variant",
-            variant,
-        ])
+        .args(["follow", &arg, "--idle-exit", "1", "--variant", variant])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     let stdout = child.stdout.take().unwrap();
-    let n = rows.len();
+    // Rows are streamed in order, each once (nothing restarts here): the
+    // k-th data line read is row k.
     let reader = std::thread::spawn(move || {
-        let mut seen = vec![None; n];
+        let mut seen = Vec::with_capacity(n);
         for line in BufReader::new(stdout).lines() {
             let line = line.unwrap();
-            let at = Instant::now();
-            if let Some(&i) = index.get(line.split(',').next().unwrap()) {
-                seen[i] = Some(at);
+            if !line.starts_with("time") {
+                seen.push(Instant::now());
             }
         }
         seen
     });
-    // Give the follower time to start and read the header.
+    // Give the follower time to start and read the headers.
     std::thread::sleep(Duration::from_millis(500));
     let dt = trial.median_dt();
     let start = Instant::now();
     let mut written = Vec::with_capacity(n);
-    for (i, row) in rows.iter().enumerate() {
+    for i in 0..n {
         let due = start + Duration::from_secs_f64(i as f64 * dt);
         if let Some(wait) = due.checked_duration_since(Instant::now()) {
             std::thread::sleep(wait);
         }
-        file.write_all(row.as_bytes()).unwrap();
-        file.flush().unwrap();
+        for (f, (_, _, rows)) in handles.iter_mut().zip(&files) {
+            f.write_all(rows[i].as_bytes()).unwrap();
+            f.flush().unwrap();
+        }
         written.push(Instant::now());
     }
     let seen = reader.join().unwrap();
@@ -108,17 +157,22 @@ fn latency(trial: &Trial, seconds: f64, variant: &str) {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let mut ms: Vec<f64> = seen
+    // An export folder's last row goes out when the final correction is
+    // written (no later packet proves every sensor wrote past it).
+    let m = seen.len().min(n);
+    assert!(m + 1 >= n, "{m} of {n} rows were streamed");
+    let mut ms: Vec<f64> = seen[..m]
         .iter()
         .zip(&written)
-        .map(|(s, w)| {
-            let s = s.expect("every row was streamed");
-            s.saturating_duration_since(*w).as_secs_f64() * 1e3
-        })
+        .map(|(s, w)| s.saturating_duration_since(*w).as_secs_f64() * 1e3)
         .collect();
     ms.sort_by(f64::total_cmp);
+    let what = match input {
+        Input::Csv => "CSV".to_string(),
+        Input::Exports => format!("{} Xsens exports", files.len()),
+    };
     println!(
-        "latency, {variant}, {n} rows at {:.0} Hz: median {:.2} ms, p99 {:.2} ms, max {:.2} ms",
+        "latency, {what}, {variant}, {m} rows at {:.0} Hz: median {:.2} ms, p99 {:.2} ms, max {:.2} ms",
         1.0 / dt,
         percentile(&ms, 0.5),
         percentile(&ms, 0.99),
@@ -253,8 +307,17 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(60.0);
     let variant = std::env::var("FOLLOW_VARIANT").unwrap_or_else(|_| "drift-centroid".into());
+    let inputs = match std::env::var("FOLLOW_INPUT").as_deref() {
+        Ok("csv") => vec![Input::Csv],
+        Ok("exports") => vec![Input::Exports],
+        _ => vec![Input::Csv, Input::Exports],
+    };
     if seconds > 0.0 {
-        latency(&trial, seconds, &variant);
+        for input in inputs {
+            latency(&trial, seconds, &variant, input);
+        }
     }
-    rms_table(&trial);
+    if std::env::var("FOLLOW_RMS").as_deref() != Ok("0") {
+        rms_table(&trial);
+    }
 }
