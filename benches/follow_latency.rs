@@ -62,7 +62,10 @@ fn csv_files(dir: &Path, trial: &Trial, n: usize) -> Files {
     let mut lines = text.split_inclusive('\n');
     let header = lines.next().unwrap().to_string();
     let rows = lines.take(n).map(str::to_string).collect();
-    (vec![(dir.join("live.csv"), header, rows)], "live.csv".into())
+    (
+        vec![(dir.join("live.csv"), header, rows)],
+        "live.csv".into(),
+    )
 }
 
 fn export_files(dir: &Path, trial: &Trial, n: usize) -> Files {
@@ -92,7 +95,11 @@ fn export_files(dir: &Path, trial: &Trial, n: usize) -> Files {
             let rows = (s.orientation.iter().take(n).enumerate())
                 .map(|(c, q)| format!("{:05}\t{}\t{}\t{}\t{}\n", c % 65_536, q.w, q.i, q.j, q.k))
                 .collect();
-            (folder.join(format!("session_{}.txt", serial(&s.name))), header, rows)
+            (
+                folder.join(format!("session_{}.txt", serial(&s.name))),
+                header,
+                rows,
+            )
         })
         .collect();
     (files, "session".into())
