@@ -54,6 +54,7 @@ pub(super) fn random_trial(names: &[&str], n: usize, seed: u64) -> Trial {
         time_s,
         imus,
         warnings: vec![],
+        orientation_decimals: None,
     }
 }
 
