@@ -69,8 +69,7 @@ fn writers_give_back_the_text_read() {
     let t = read_trial_from_str(sto, "s.sto", S, &opensim()).unwrap();
     assert_eq!(trial_to_string(&t, S), sto);
     // Euler angles within the writer's ranges, away from pitch +-90.
-    let euler =
-        "time,base_roll,base_pitch,base_yaw\n0,10.25,-3.5,120.125\n0.02,-170,45.001,-0.5\n";
+    let euler = "time,base_roll,base_pitch,base_yaw\n0,10.25,-3.5,120.125\n0.02,-170,45.001,-0.5\n";
     let t = read_trial_from_str(euler, "e.csv", E, &infant()).unwrap();
     assert_eq!(trial_to_string(&t, E), euler);
     // Quaternions read, Euler angles written: full precision, and the reverse.
@@ -87,8 +86,7 @@ fn writers_give_back_the_text_read() {
 #[test]
 fn files_with_fewer_decimals_than_a_sensor_gives_are_exact_values() {
     // Three decimals of quaternions: kept as read, written in full.
-    let three =
-        "time,base_qw,base_qx,base_qy,base_qz\n0,0.6,0.8,0,0\n0.02,0.707,0.707,0,0\n";
+    let three = "time,base_qw,base_qx,base_qy,base_qz\n0,0.6,0.8,0,0\n0.02,0.707,0.707,0,0\n";
     let t = read_trial_from_str(three, "a.csv", Q, &infant()).unwrap();
     assert_eq!(
         t.orientation_decimals,
