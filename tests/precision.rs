@@ -318,3 +318,40 @@ fn precision_n_and_from_sidecar_reproduce_the_bytes() {
     let message = String::from_utf8_lossy(&bad.stderr);
     assert!(message.contains("0..=17"), "{message}");
 }
+
+/// The figures the README quotes: size and write time of a 5-minute
+/// 13-IMU trial (50 Hz) at six decimals against full precision. Run with
+/// `cargo test --test precision -- --ignored --nocapture` (one run; times
+/// vary with the machine).
+#[test]
+#[ignore]
+fn size_and_write_time_of_a_five_minute_trial() {
+    use acm_workbench::trial::precision::Precision;
+    use acm_workbench::trial::{write_trial_hashed, TrialFormat};
+    use std::time::Instant;
+    let dir = tempfile::tempdir().unwrap();
+    let model = Model::infant13();
+    let sim = simulate_with(&SimConfig::full_body(5), &model)
+        .unwrap()
+        .trial;
+    let six = dir.path().join("six.csv");
+    write_trial_hashed(&sim, &six, TrialFormat::QuatCsv, Precision::Decimals(6)).unwrap();
+    let trial = read_trial(&six, &model).unwrap();
+    assert_eq!(trial.orientation_decimals.map(|d| d.most), Some(6));
+    let mut sizes = Vec::new();
+    for (name, precision) in [("auto.csv", Precision::Auto), ("full.csv", Precision::Full)] {
+        let path = dir.path().join(name);
+        let start = Instant::now();
+        write_trial_hashed(&trial, &path, TrialFormat::QuatCsv, precision).unwrap();
+        let elapsed = start.elapsed();
+        let size = std::fs::metadata(&path).unwrap().len();
+        println!(
+            "{} samples x {} IMUs, {precision}: {size} bytes in {:.1} ms",
+            trial.len(),
+            trial.imus.len(),
+            elapsed.as_secs_f64() * 1e3
+        );
+        sizes.push(size);
+    }
+    assert!(sizes[0] < sizes[1]);
+}
