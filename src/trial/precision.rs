@@ -13,7 +13,7 @@
 //! * `full`, a trial without a record (simulated, computed), a record of
 //!   [`FULL_FROM`] or more decimals, or a record of the other kind of
 //!   numbers (Euler angles read, quaternions written, or the reverse):
-//!   today's shortest round-trip text ([`super::io::number::push_f64`]).
+//!   today's shortest round-trip text (what `format!("{v}")` writes).
 //! * `auto` with fewer decimals than a measuring device gives
 //!   ([`QUATERNION_FLOOR`] for quaternion components, [`EULER_FLOOR`] for
 //!   degrees: about 0.01 degree either way): the numbers are taken as exact
@@ -104,7 +104,9 @@ impl Decimals {
 /// kept (`padded`) or trimmed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Fixed {
+    /// Decimal places every number is rounded to.
     pub decimals: u8,
+    /// Whether trailing zeros are written (`0.500000`) or trimmed (`0.5`).
     pub padded: bool,
 }
 
