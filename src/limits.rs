@@ -15,6 +15,7 @@
 //! `joint_limits/settings.toml` (see [`Settings`]).
 
 use crate::model::Model;
+use crate::trial::precision::Precision;
 use crate::vertical::Vertical;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -122,6 +123,10 @@ pub struct Settings {
     /// to compare against).
     #[serde(default, skip_serializing_if = "Solver::is_default")]
     pub solver: Solver,
+    /// The decimals orientation numbers are written with (`--precision`;
+    /// does not change the correction). Left out when `auto`.
+    #[serde(default, skip_serializing_if = "Precision::is_auto")]
+    pub precision: Precision,
 }
 
 impl Default for Settings {
@@ -132,6 +137,7 @@ impl Default for Settings {
             hop_s: 30.0,
             vertical: Vertical::ZUp,
             solver: Solver::default(),
+            precision: Precision::Auto,
         }
     }
 }
@@ -199,6 +205,7 @@ impl SettingsFile {
             hop_s: self.hop_s,
             vertical: self.vertical,
             solver: Solver::default(),
+            precision: Precision::Auto,
         }
     }
 

@@ -10,6 +10,7 @@ use crate::metrics::{trial_figures, JointFigures};
 use crate::model::Model;
 use crate::pose::PoseRecord;
 use crate::save::{atomic_write, OutputLock};
+use crate::trial::precision::{AngleNumbers, Fixed};
 use crate::trial::{write_trial_hashed, Trial, TrialFormat};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -56,6 +57,11 @@ pub struct Sidecar {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output_sha256: Option<String>,
     pub output_format: TrialFormat,
+    /// How the output's orientation numbers were written, from
+    /// `settings.precision` and the input's decimals: fixed decimals, or
+    /// absent for full precision (shortest round-trip digits).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_precision: Option<Fixed>,
     pub variant: Variant,
     pub settings: Settings,
     pub model: Model,
@@ -115,6 +121,10 @@ impl Sidecar {
             output: output.display().to_string(),
             output_sha256: None,
             output_format,
+            output_precision: correction.settings.precision.style(
+                correction.corrected.orientation_decimals,
+                AngleNumbers::written_in(output_format),
+            ),
             variant: correction.variant,
             settings: correction.settings,
             model: model.clone(),
@@ -348,8 +358,12 @@ impl SaveRequest<'_> {
         }
         let _lock = OutputLock::acquire(self.output)
             .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", self.output.display()))?;
-        let written =
-            write_trial_hashed(&self.correction.corrected, self.output, self.output_format)?;
+        let written = write_trial_hashed(
+            &self.correction.corrected,
+            self.output,
+            self.output_format,
+            self.correction.settings.precision,
+        )?;
         sidecar.output_sha256 = Some(written);
         if let Some(run) = &self.correction.ik {
             write_coordinates(run, &coordinates_path(self.output))?;

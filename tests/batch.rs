@@ -336,3 +336,51 @@ fn four_shards_run_at_once_and_merged_equal_one_unsharded_run() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("missing for 3/4"), "{stderr}");
 }
+
+#[test]
+fn outputs_keep_the_inputs_decimals_and_precision_full_redoes_them() {
+    use acm_workbench::trial::precision::{decimals_of, Precision};
+    use acm_workbench::trial::write_trial_hashed;
+    let dir = tempfile::tempdir().unwrap();
+    let trials = dir.path().join("trials");
+    std::fs::create_dir_all(&trials).unwrap();
+    for k in 0..2 {
+        let mut cfg = SimConfig::full_body(200 + k);
+        cfg.duration_s = 40.0;
+        let sim = simulate(&cfg).unwrap();
+        let path = trials.join(format!("six{k}.csv"));
+        write_trial_hashed(
+            &sim.trial,
+            &path,
+            TrialFormat::QuatCsv,
+            Precision::Decimals(6),
+        )
+        .unwrap();
+    }
+    let most_decimals = |out: &Path| -> Vec<u8> {
+        let m = manifest(out);
+        m.rows
+            .iter()
+            .map(|r| {
+                let text = std::fs::read_to_string(dir.path().join(&r.output)).unwrap();
+                let cells = text.lines().skip(1).flat_map(|l| l.split(',').skip(1));
+                cells.map(decimals_of).max().unwrap()
+            })
+            .collect()
+    };
+    let batch = |extra: &[&str]| {
+        let mut args = vec![
+            "batch", "trials", "--out", "out", "--window", "20", "--hop", "10", "--quiet",
+        ];
+        args.extend(extra);
+        common::acmw_ok(dir.path(), &args);
+    };
+    let out = dir.path().join("out");
+    batch(&[]);
+    assert_eq!(most_decimals(&out), [6, 6]);
+    let auto_hash = manifest(&out).rows[0].settings_sha256.clone();
+    // Another precision is another output: the trials are done again.
+    batch(&["--precision", "full"]);
+    assert!(most_decimals(&out).iter().all(|&d| d > 6));
+    assert_ne!(manifest(&out).rows[0].settings_sha256, auto_hash);
+}

@@ -200,6 +200,7 @@ fn physical_trial(
         imus,
         time_s,
         warnings: vec![],
+        orientation_decimals: None,
     }
 }
 

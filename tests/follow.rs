@@ -385,6 +385,49 @@ fn a_pose_calibration_waits_for_its_span_then_calibrates_the_rows_after() {
 }
 
 #[test]
+fn a_six_decimal_trial_is_followed_and_written_at_six_decimals() {
+    use acm_workbench::trial::precision::{decimals_of, Precision};
+    use acm_workbench::trial::trial_to_string_at;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("growing.csv");
+    let text = trial_to_string_at(
+        &drifting(60.0, 8),
+        TrialFormat::QuatCsv,
+        Precision::Decimals(6),
+    );
+    let child = follow(dir.path(), &input, &[]);
+    write_in_fragments(&input, text.as_bytes(), 3.0, 4);
+    finish(child);
+    // Live rows (raw before the first solve, corrected after) and the final
+    // correction: six decimals at most, the final equal to acmw correct's.
+    let orientation_decimals = |text: &str| -> Vec<u8> {
+        text.lines()
+            .skip(1)
+            .flat_map(|l| l.split(',').skip(1).map(decimals_of).collect::<Vec<_>>())
+            .collect()
+    };
+    let stream = std::fs::read_to_string(dir.path().join("stream.csv")).unwrap();
+    let fin = std::fs::read_to_string(dir.path().join("final.csv")).unwrap();
+    for written in [&stream, &fin] {
+        let d = orientation_decimals(written);
+        assert!(d.iter().all(|&d| d <= 6) && d.iter().filter(|&&d| d == 6).count() > d.len() / 2);
+    }
+    let (offline, offline_sidecar) = correct(dir.path(), &input);
+    assert!(
+        fin.as_bytes() == offline,
+        "the final correction differs from acmw correct"
+    );
+    assert_eq!(sidecar(&dir.path().join("final.json")), offline_sidecar);
+    assert_eq!(offline_sidecar["output_precision"]["decimals"], 6);
+    let written = read_trial(&input, &model()).unwrap();
+    check_stream(
+        &dir.path().join("stream.csv"),
+        &written,
+        TrialFormat::QuatCsv,
+    );
+}
+
+#[test]
 fn truncation_is_noticed_and_an_euler_trial_followed_from_its_start() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("growing.csv");

@@ -693,3 +693,74 @@ fn xsens_gyroscope_columns_stay_aligned_with_the_orientations() {
     assert_eq!((e.line, e.column), (10, 8), "{e}");
     assert!(e.message.contains("Gyr_Y, found 'fast'"), "{e}");
 }
+
+#[test]
+fn xsens_exports_at_six_decimals_are_corrected_into_a_six_decimal_sto() {
+    use acm_workbench::trial::precision::{decimals_of, AngleNumbers};
+    let dir = tempfile::tempdir().unwrap();
+    let mut sensors = sensors();
+    for s in &mut sensors {
+        s.columns = Columns::Quaternion;
+    }
+    write_recording(dir.path(), "IMUData", &sensors, None);
+    // MT Manager writes `%.6f`: six decimals, trailing zeros kept.
+    for s in &sensors {
+        let f = dir
+            .path()
+            .join(format!("IMUData/MT_TEST-001_{}.txt", s.serial));
+        let text = std::fs::read_to_string(&f).unwrap();
+        let six: Vec<String> = text
+            .lines()
+            .map(|l| match l.split('\t').collect::<Vec<_>>() {
+                cells if cells.len() == 10 && !l.starts_with("Packet") => {
+                    let mut out: Vec<String> = cells[..6].iter().map(|c| c.to_string()).collect();
+                    out.extend(
+                        cells[6..]
+                            .iter()
+                            .map(|c| format!("{:.6}", c.parse::<f64>().unwrap())),
+                    );
+                    out.join("\t")
+                }
+                _ => l.to_string(),
+            })
+            .collect();
+        std::fs::write(&f, six.join("\n") + "\n").unwrap();
+    }
+    let xml = dir.path().join("myIMUMappings.xml");
+    let model = detect_model(&xml);
+    let trial = read_trial(&xml, &model).unwrap();
+    let d = trial.orientation_decimals.unwrap();
+    assert_eq!(
+        (d.numbers, d.most, d.padded()),
+        (AngleNumbers::Quaternion, 6, true)
+    );
+    let out = dir.path().join("out.sto");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_acmw"))
+        .arg("correct")
+        .arg(&xml)
+        .args(["--variant", "none", "-q", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    let rows = text.lines().skip_while(|l| !l.starts_with("time")).skip(1);
+    let numbers: Vec<u8> = rows
+        .flat_map(|l| {
+            l.split('\t')
+                .skip(1)
+                .flat_map(|c| c.split(','))
+                .map(decimals_of)
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    assert_eq!(numbers.len(), trial.len() * 3 * 4);
+    assert!(
+        numbers.iter().all(|&d| d == 6),
+        "every number padded to six decimals"
+    );
+}

@@ -31,6 +31,8 @@ struct Run {
     /// Output file name (its extension picks gzip; `--format` follows).
     output: &'static str,
     format: Option<&'static str>,
+    /// `--precision`, when given.
+    precision: Option<&'static str>,
 }
 
 fn runs() -> Vec<Run> {
@@ -43,6 +45,7 @@ fn runs() -> Vec<Run> {
                 variant: v.name(),
                 output: "out.csv",
                 format: None,
+                precision: None,
             });
         }
     }
@@ -58,6 +61,41 @@ fn runs() -> Vec<Run> {
             variant,
             output,
             format: Some(format),
+            precision: None,
+        });
+    }
+    runs.extend(full_precision_runs());
+    runs
+}
+
+/// The sample trials hold six decimals, which `auto` keeps: these runs
+/// write them at `--precision full`, whose orientation files are to be the
+/// bytes every run wrote before outputs kept the input's precision (the
+/// sidecars differ by the `precision` setting they record).
+fn full_precision_runs() -> Vec<Run> {
+    let mut runs = Vec::new();
+    let knee = "knee_calf_z15.csv.gz";
+    let on_knee = Variant::ALL
+        .iter()
+        .map(|v| (knee, v.name(), "out.csv", None));
+    let others = TRIALS[1..]
+        .iter()
+        .map(|&t| (t, "drift-centroid", "out.csv", None));
+    let formats = [
+        (knee, "drift-centroid", "out.csv", Some("euler-csv")),
+        (knee, "drift-centroid", "out.sto.gz", Some("sto")),
+    ];
+    for (trial, variant, output, format) in on_knee.chain(others).chain(formats) {
+        runs.push(Run {
+            label: format!(
+                "{trial} {variant}{} precision-full",
+                format.map_or(String::new(), |f| format!(" {f}"))
+            ),
+            trial,
+            variant,
+            output,
+            format,
+            precision: Some("full"),
         });
     }
     runs
@@ -94,6 +132,9 @@ fn run_hashes(run: &Run, repo: &Path) -> BTreeMap<String, String> {
     ];
     if let Some(f) = run.format {
         args.extend(["--format".into(), f.into()]);
+    }
+    if let Some(p) = run.precision {
+        args.extend(["--precision".into(), p.into()]);
     }
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     acmw_ok(&cwd, &args);

@@ -98,7 +98,7 @@ prop_compose! {
                 ImuSeries::new(*name, q).with_gyro(gyro)
             })
             .collect();
-        Trial { name: "p".into(), time_s, imus, warnings: vec![] }
+        Trial { name: "p".into(), time_s, imus, warnings: vec![], orientation_decimals: None }
     }
 }
 

@@ -49,6 +49,7 @@ fn random_trial(rng: &mut ChaCha8Rng) -> Trial {
         time_s,
         imus,
         warnings: vec![],
+        orientation_decimals: None,
     }
 }
 

@@ -245,6 +245,7 @@ fn applying_the_calibration_gives_the_segment_orientation() {
             seg.iter().map(|s| s * m).collect(),
         )],
         warnings: vec![],
+        orientation_decimals: None,
     };
     let applied = AppliedCalibration {
         file: "c.toml".into(),

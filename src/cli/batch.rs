@@ -2,7 +2,9 @@
 //! with a manifest a re-run resumes from; `--shard K/N` for clusters,
 //! `--merge` to join the shards' manifests.
 
-use super::common::{load_calibration, load_context, variant_parser, EngineArgs, PoseArgs};
+use super::common::{
+    load_calibration, load_context, variant_parser, EngineArgs, PoseArgs, PrecisionArgs,
+};
 use acm_workbench::batch::manifest::{Manifest, Status};
 use acm_workbench::batch::{discover, Batch, Event, Shard};
 use acm_workbench::correct::pipeline::Preparation;
@@ -51,6 +53,8 @@ pub struct BatchArgs {
     pub engine: EngineArgs,
     #[command(flatten)]
     pub pose: PoseArgs,
+    #[command(flatten)]
+    pub output_precision: PrecisionArgs,
     /// No progress bar and no line per trial (failures and the summary only),
     /// for logs.
     #[arg(short, long)]
@@ -67,7 +71,8 @@ pub fn run(args: BatchArgs) -> anyhow::Result<i32> {
         "--threads does not apply to batch: --jobs N sets the workers"
     );
     let trials = discover(&args.inputs)?;
-    let ctx = load_context(&args.engine, || Ok(Model::infant13()))?;
+    let mut ctx = load_context(&args.engine, || Ok(Model::infant13()))?;
+    args.output_precision.apply(&mut ctx.settings);
     let model: Option<Model> = args.engine.model.as_ref().map(|_| ctx.model.clone());
     let pose = args.pose.calibration(model.as_ref().unwrap_or(&ctx.model));
     let preparation = Preparation {

@@ -6,6 +6,7 @@ use acm_workbench::limits::{LimitTable, LimitsDir, LimitsError, Settings, Settin
 use acm_workbench::model::{Model, SignedAxis};
 use acm_workbench::names::Named;
 use acm_workbench::pose::{PoseCalibration, PoseTime};
+use acm_workbench::trial::precision::Precision;
 use acm_workbench::trial::TrialFile;
 use acm_workbench::variant::{Variant, VARIANTS};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
@@ -45,6 +46,29 @@ pub struct EngineArgs {
     /// Worker threads [default: all cores]; results do not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
+}
+
+/// `--precision` of the commands that write corrected trials (`correct`,
+/// `batch`, `follow`).
+#[derive(Debug, Clone, Args, Default)]
+pub struct PrecisionArgs {
+    /// Decimal places of the orientation numbers written (quaternion
+    /// components; Euler angles in degrees): `auto` as many as the input's
+    /// had (full when it had 15 or more, fewer than 4 for quaternions or 2
+    /// for degrees, or was of the other kind), `full` shortest round-trip
+    /// digits (up to 17 significant), or N (0-17; 15 or more is full)
+    /// [default: auto, or the sidecar's with --from-sidecar].
+    #[arg(long, value_name = "auto|full|N", value_parser = Precision::parse)]
+    pub precision: Option<Precision>,
+}
+
+impl PrecisionArgs {
+    /// Puts the precision asked for, if any, into `settings`.
+    pub fn apply(&self, settings: &mut Settings) {
+        if let Some(p) = self.precision {
+            settings.precision = p;
+        }
+    }
 }
 
 /// Pose calibration before the correction (shared by `correct` and `report`).
@@ -208,6 +232,7 @@ pub fn load_context(
         hop_s: args.hop.unwrap_or(defaults.hop_s),
         vertical: args.vertical.unwrap_or(defaults.vertical),
         solver: args.solver.unwrap_or(defaults.solver),
+        precision: defaults.precision,
     };
     if let Some(p) = settings.problem() {
         return Err(flag_error(args, &p).into());

@@ -2,7 +2,7 @@
 
 use super::common::{
     context_and_file, load_calibration, load_prepared, set_threads, variant_parser, Context,
-    EngineArgs, PoseArgs, Progress,
+    EngineArgs, PoseArgs, PrecisionArgs, Progress,
 };
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation};
@@ -47,6 +47,8 @@ pub struct CorrectArgs {
     pub engine: EngineArgs,
     #[command(flatten)]
     pub pose: PoseArgs,
+    #[command(flatten)]
+    pub output_precision: PrecisionArgs,
     /// No progress or summary output.
     #[arg(short, long)]
     pub quiet: bool,
@@ -55,7 +57,7 @@ pub struct CorrectArgs {
 /// Runs `acmw correct`.
 pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
     let mut recorded_calibration = None;
-    let (ctx, variant, pose, file) = match &args.from_sidecar {
+    let (mut ctx, variant, pose, file) = match &args.from_sidecar {
         Some(p) => {
             let s = Sidecar::load_checked(p)?;
             let origin = p.display().to_string();
@@ -97,6 +99,7 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             (ctx, args.variant, pose, file)
         }
     };
+    args.output_precision.apply(&mut ctx.settings);
     let calibration = match recorded_calibration {
         Some(c) => Some(c),
         None => load_calibration(args.calibration.as_deref())?,

@@ -4,6 +4,7 @@
 
 use super::common::{
     load_calibration, load_context, load_prepared, variant_parser, EngineArgs, PoseArgs,
+    PrecisionArgs,
 };
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::pipeline::{self, Preparation, Source};
@@ -11,7 +12,7 @@ use acm_workbench::follow::{
     exports_ready, push, Extrapolation, Follower, FollowerConfig, LiveSource, Look,
 };
 use acm_workbench::trial::format::{is_followable, is_stream_format};
-use acm_workbench::trial::{detect_model, trial_to_string, TrialFormat};
+use acm_workbench::trial::{detect_model, trial_to_string_at, TrialFormat};
 use anyhow::Context as _;
 use clap::Args;
 use std::io::Write;
@@ -77,6 +78,9 @@ pub struct FollowArgs {
     /// rows so far and applied to every later row and solve.
     #[command(flatten)]
     pub pose: PoseArgs,
+    /// Also the live rows' precision (`auto`: as the rows read so far had).
+    #[command(flatten)]
+    pub output_precision: PrecisionArgs,
     /// No messages on standard error but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -213,7 +217,8 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
         }
         anyhow::bail!("{name}: no header line arrived: expected a trial being written");
     }
-    let ctx = load_context(&args.engine, || Ok(detect_model(input)))?;
+    let mut ctx = load_context(&args.engine, || Ok(detect_model(input)))?;
+    args.output_precision.apply(&mut ctx.settings);
     let variant = args.variant;
     let config = FollowerConfig {
         model: ctx.model.clone(),
@@ -286,7 +291,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
                     let fmt = *format
                         .get_or_insert_with(|| follower.format().unwrap_or(TrialFormat::QuatCsv));
                     if let Some(batch) = follower.corrected(range) {
-                        sink.write(&trial_to_string(&batch, fmt))?;
+                        sink.write(&trial_to_string_at(&batch, fmt, s.precision))?;
                     }
                 }
             }
@@ -337,7 +342,7 @@ pub fn run(args: FollowArgs) -> anyhow::Result<i32> {
             let range = push(&mut follower, got)?;
             if let (false, Some(batch)) = (range.is_empty(), follower.corrected(range.clone())) {
                 let fmt = format.unwrap_or(TrialFormat::QuatCsv);
-                sink.write(&trial_to_string(&batch, fmt))?;
+                sink.write(&trial_to_string_at(&batch, fmt, s.precision))?;
             }
         }
     }

@@ -176,6 +176,7 @@ impl Solution {
             time_s,
             imus,
             warnings: Vec::new(),
+            orientation_decimals: trial.orientation_decimals,
         }
     }
 }

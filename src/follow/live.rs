@@ -8,6 +8,7 @@ use crate::correct::pipeline::{self, Preparation, Setup};
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
 use crate::pose::{PoseCalibration, PoseRecord};
+use crate::trial::precision::Decimals;
 use crate::trial::{
     csv_format_of_header, read_rows_from_str, ImuSeries, Trial, TrialError, TrialFormat,
 };
@@ -490,11 +491,15 @@ fn prefix(trial: &Trial, n: usize) -> Trial {
             })
             .collect(),
         warnings: trial.warnings.clone(),
+        orientation_decimals: trial.orientation_decimals,
     }
 }
 
-/// Appends `batch`'s samples (same IMUs, later times) to `trial`.
+/// Appends `batch`'s samples (same IMUs, later times) to `trial`, and its
+/// decimal places (as if read at once).
 fn append(trial: &mut Trial, batch: Trial) {
+    trial.orientation_decimals =
+        Decimals::merge(trial.orientation_decimals, batch.orientation_decimals);
     trial.time_s.extend(batch.time_s);
     for (s, b) in trial.imus.iter_mut().zip(batch.imus) {
         s.orientation.extend(b.orientation);

@@ -185,6 +185,7 @@ pub fn simulate(model: &Model, config: &IkSimConfig) -> IkSim {
             .map(|(s, orientation)| ImuSeries::new(s.imu.clone(), orientation))
             .collect(),
         warnings: vec![],
+        orientation_decimals: None,
     };
     IkSim {
         trial: trial("ik_sim", measured),

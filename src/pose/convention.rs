@@ -174,6 +174,7 @@ mod tests {
             ],
             time_s,
             warnings: vec![],
+            orientation_decimals: None,
         }
     }
 

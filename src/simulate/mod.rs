@@ -534,6 +534,7 @@ pub fn simulate_with(config: &SimConfig, model: &Model) -> Result<Simulated, Sim
         time_s: time_s.clone(),
         imus: measured,
         warnings: vec![],
+        orientation_decimals: None,
     };
     let truth = Truth {
         segments: Trial {
@@ -544,6 +545,7 @@ pub fn simulate_with(config: &SimConfig, model: &Model) -> Result<Simulated, Sim
                 .map(|(name, orientation)| ImuSeries::new(name, orientation))
                 .collect(),
             warnings: vec![],
+            orientation_decimals: None,
         },
         meta: TruthMeta {
             model: model.name.clone(),

@@ -114,6 +114,7 @@ mod tests {
                     .collect(),
             )],
             warnings: vec![],
+            orientation_decimals: None,
         }
     }
 

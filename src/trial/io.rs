@@ -33,6 +33,7 @@ mod file;
 pub(crate) mod number;
 pub(crate) mod parse;
 
+use super::precision::{push_fixed, AngleNumbers, Fixed, Precision};
 pub use file::TrialFile;
 use number::push_f64;
 use parse::{classify_csv_header, first_header, parse_header, parse_trial, LineIter};
@@ -416,22 +417,25 @@ impl TrialHead {
 }
 
 /// Writes a trial in `format`; gzip-compressed when the path ends in `.gz`.
-/// Atomic, keeping the previous file as `<name>.bak` ([`crate::save::atomic_write`]).
+/// Orientation numbers are written with the decimals they were read with
+/// ([`Precision::Auto`]). Atomic, keeping the previous file as `<name>.bak`
+/// ([`crate::save::atomic_write`]).
 pub fn write_trial(
     trial: &Trial,
     path: &Path,
     format: TrialFormat,
 ) -> Result<(), crate::save::WriteError> {
-    write_trial_hashed(trial, path, format).map(|_| ())
+    write_trial_hashed(trial, path, format, Precision::Auto).map(|_| ())
 }
 
-/// [`write_trial`], returning the SHA-256 (hex) of the bytes written (the
-/// file as stored, compressed when gzip), hashed from memory as they go to
-/// disk rather than read back.
+/// [`write_trial`] with orientation numbers at `precision`, returning the
+/// SHA-256 (hex) of the bytes written (the file as stored, compressed when
+/// gzip), hashed from memory as they go to disk rather than read back.
 pub fn write_trial_hashed(
     trial: &Trial,
     path: &Path,
     format: TrialFormat,
+    precision: Precision,
 ) -> Result<String, crate::save::WriteError> {
     let origin = origin_of(path);
     let refused = |message: String| crate::save::WriteError {
@@ -484,7 +488,7 @@ pub fn write_trial_hashed(
             format.extension()
         )));
     }
-    let text = trial_to_string(trial, format);
+    let text = trial_to_string_at(trial, format, precision);
     let bytes = if gzip {
         let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
         enc.write_all(text.as_bytes())
@@ -499,21 +503,37 @@ pub fn write_trial_hashed(
 }
 
 /// Appends `first` then the numbers of `values` separated by `sep`, each as
-/// `{}` writes it ([`push_f64`]).
+/// `{}` writes it ([`push_f64`]), or in fixed notation with `style`.
 #[inline]
-fn push_cells(out: &mut String, first: char, sep: char, values: &[f64]) {
+fn push_cells(out: &mut String, first: char, sep: char, values: &[f64], style: Option<Fixed>) {
     for (k, &v) in values.iter().enumerate() {
         out.push(if k == 0 { first } else { sep });
-        push_f64(out, v);
+        match style {
+            Some(style) => push_fixed(out, v, style),
+            None => push_f64(out, v),
+        }
     }
 }
 
-/// The text of a trial in `format` (uncompressed). Numbers use Rust's shortest
-/// round-trip formatting; quaternions are written with `w >= 0`. In the CSV
-/// formats an IMU's gyroscope readings, when it has them, follow its
-/// orientation columns as `<imu>_gx,<imu>_gy,<imu>_gz` (rad/s, sensor frame);
-/// `.sto` has no place for them.
+/// The text of a trial in `format` (uncompressed), orientation numbers with
+/// the decimals they were read with ([`trial_to_string_at`] with
+/// [`Precision::Auto`]).
 pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
+    trial_to_string_at(trial, format, Precision::Auto)
+}
+
+/// The text of a trial in `format` (uncompressed). Orientation numbers
+/// (quaternion components, Euler angles) are written at `precision`
+/// against the trial's [`Trial::orientation_decimals`]
+/// ([`Precision::style`]); times and gyroscope readings, and orientations
+/// at full precision, in Rust's shortest round-trip formatting.
+/// Quaternions are written with `w >= 0`. In the CSV formats an IMU's
+/// gyroscope readings, when it has them, follow its orientation columns as
+/// `<imu>_gx,<imu>_gy,<imu>_gz` (rad/s, sensor frame); `.sto` has no place
+/// for them.
+pub fn trial_to_string_at(trial: &Trial, format: TrialFormat, precision: Precision) -> String {
+    let numbers = AngleNumbers::written_in(format);
+    let style = precision.style(trial.orientation_decimals, numbers);
     let n = trial
         .imus
         .iter()
@@ -547,13 +567,13 @@ pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
                     let q = &s.orientation[i];
                     if format == TrialFormat::QuatCsv {
                         let q = canonical(q);
-                        push_cells(&mut out, ',', ',', &[q.w, q.i, q.j, q.k]);
+                        push_cells(&mut out, ',', ',', &[q.w, q.i, q.j, q.k], style);
                     } else {
-                        push_cells(&mut out, ',', ',', &euler_zyx_deg(q));
+                        push_cells(&mut out, ',', ',', &euler_zyx_deg(q), style);
                     }
                     if let Some(g) = &s.gyro {
                         let w = &g[i];
-                        push_cells(&mut out, ',', ',', &[w.x, w.y, w.z]);
+                        push_cells(&mut out, ',', ',', &[w.x, w.y, w.z], None);
                     }
                 }
                 out.push('\n');
@@ -573,7 +593,7 @@ pub fn trial_to_string(trial: &Trial, format: TrialFormat) -> String {
                 push_f64(&mut out, trial.time_s[i]);
                 for s in &trial.imus {
                     let q = canonical(&s.orientation[i]);
-                    push_cells(&mut out, '\t', ',', &[q.w, q.i, q.j, q.k]);
+                    push_cells(&mut out, '\t', ',', &[q.w, q.i, q.j, q.k], style);
                 }
                 out.push('\n');
             }

@@ -15,6 +15,7 @@ pub mod format;
 pub mod glitch;
 mod io;
 pub mod mapping;
+pub mod precision;
 pub mod timing;
 pub mod xsens;
 pub mod xsens_trial;
@@ -75,6 +76,11 @@ pub struct Trial {
     pub imus: Vec<ImuSeries>,
     /// Things the reader noticed that are not errors (renormalised quaternions, ...).
     pub warnings: Vec<String>,
+    /// The decimal places of the orientation numbers in the file the trial
+    /// was read from, which writers keep ([`precision`]); `None` for full
+    /// precision or unknown (simulated or computed trials). Trials made
+    /// from a read one (cut, calibrated, corrected) keep it.
+    pub orientation_decimals: Option<precision::Decimals>,
 }
 
 /// The file formats a trial can be read from and written to.
@@ -139,6 +145,7 @@ impl Trial {
                 })
                 .collect(),
             warnings: self.warnings.clone(),
+            orientation_decimals: self.orientation_decimals,
         }
     }
 
@@ -228,6 +235,7 @@ mod tests {
             time_s: (0..3000).map(|i| i as f64 * 0.02).collect(),
             imus: vec![],
             warnings: vec![],
+            orientation_decimals: None,
         };
         assert!((t.duration_s() - 60.0).abs() < 1e-9);
         assert!((t.rate_hz() - 50.0).abs() < 1e-9);

@@ -37,6 +37,7 @@
 use super::io::parse::{show, LineIter, NORM_NOTE, NORM_TOLERANCE};
 use super::TrialError;
 use crate::rotation::{quat_from_euler_zyx_deg, Quat};
+use crate::trial::precision::{AngleNumbers, Decimals, Tally};
 use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
 
 /// The packet counter's modulus (it is 16 bits wide).
@@ -134,6 +135,9 @@ pub struct XsensExport {
     pub gyro: Option<Vec<Vector3<f64>>>,
     /// Quaternions renormalised by more than [`NORM_NOTE`] (count).
     pub renormalised: usize,
+    /// Decimal places of the quaternion or Euler numbers read (`None` for
+    /// rotation matrices and numbers at full precision).
+    pub decimals: Option<Decimals>,
 }
 
 /// Column indices (0-based) of what the reader needs.
@@ -424,6 +428,8 @@ pub struct ExportReader {
     last_raw: Option<(u64, u64)>,
     /// Wraps of the 16-bit counter so far.
     wraps: u64,
+    /// Decimal places of the orientation numbers so far.
+    tally: Tally,
 }
 
 impl ExportReader {
@@ -443,11 +449,23 @@ impl ExportReader {
                 columns: OrientationColumns::Quaternion,
                 gyro: None,
                 renormalised: 0,
+                decimals: None,
             },
             header: None,
             ticks: Vec::new(),
             last_raw: None,
             wraps: 0,
+            tally: Tally::default(),
+        }
+    }
+
+    /// The decimal places of the quaternion or Euler numbers read so far
+    /// (`None` for rotation matrices, full precision, or nothing read).
+    pub fn decimals(&self) -> Option<Decimals> {
+        match self.header.as_ref()?.cols.kind {
+            OrientationColumns::Quaternion => self.tally.finish(AngleNumbers::Quaternion),
+            OrientationColumns::Euler => self.tally.finish(AngleNumbers::EulerDeg),
+            OrientationColumns::Matrix => None,
         }
     }
 
@@ -529,6 +547,10 @@ impl ExportReader {
         }
         let mut renormalised = 0;
         let q = orientation(&reader, cells, cols, names, line, &mut renormalised)?;
+        for &k in &cols.fields {
+            // Read by `orientation`: present and not empty.
+            self.tally.see(cells[k].trim().trim_matches('"').trim());
+        }
         let gyro = match cols.gyro {
             Some(fields) => {
                 let [x, y, z] = fields.map(|k| reader.number(cells, k, line, &names[k]));
@@ -616,6 +638,7 @@ impl ExportReader {
         if header.cols.sample_time.is_some() {
             self.out.sample_time_rate_hz = rate_of_sample_time(&self.out.counters, &self.ticks);
         }
+        self.out.decimals = self.decimals();
         Ok(self.out)
     }
 }

@@ -13,6 +13,7 @@
 //! (`Gyr_X Gyr_Y Gyr_Z`, rad/s, sensor frame) are aligned the same way.
 
 use super::mapping::{looks_like_mapping, parse_mapping, sensor_to_opensim, Mapping};
+use super::precision::Decimals;
 use super::xsens::{parse_export, ExportReader, XsensExport, COUNTER_MODULUS};
 use super::{ImuSeries, Trial, TrialError};
 use crate::model::Model;
@@ -513,6 +514,7 @@ impl GrowingExports {
             time_s,
             imus,
             warnings: vec![],
+            orientation_decimals: merged(self.readers.iter().map(ExportReader::decimals)),
         }))
     }
 
@@ -545,6 +547,7 @@ impl GrowingExports {
                     columns: e.columns,
                     gyro: None,
                     renormalised: 0,
+                    decimals: None,
                 };
                 (String::new(), head)
             })
@@ -783,7 +786,15 @@ pub(crate) fn assemble(
         time_s,
         imus,
         warnings,
+        orientation_decimals: merged(exports.iter().map(|(_, e)| e.decimals)),
     })
+}
+
+/// The decimal places of a trial's exports' orientation numbers, as if
+/// read from one file.
+fn merged(mut each: impl Iterator<Item = Option<Decimals>>) -> Option<Decimals> {
+    let first = each.next()?;
+    each.fold(first, Decimals::merge)
 }
 
 /// A packet every export recorded: its counter and its index in each export.

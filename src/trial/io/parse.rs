@@ -6,6 +6,7 @@
 use super::number::parse_f64;
 use crate::model::Model;
 use crate::rotation::{quat_from_euler_zyx_deg, Quat};
+use crate::trial::precision::{AngleNumbers, Tally};
 use crate::trial::{ImuSeries, Trial, TrialError, TrialFormat};
 use nalgebra::{Quaternion, Vector3};
 
@@ -540,10 +541,14 @@ struct Acc<'a> {
     /// Gyroscope readings per IMU (empty for IMUs without gyroscope columns).
     gyro: Vec<Vec<Vector3<f64>>>,
     renorm: Vec<Renorm>,
+    /// Decimal places of the orientation numbers read.
+    tally: Tally,
+    /// What the orientation numbers are.
+    numbers: AngleNumbers,
 }
 
 impl<'a> Acc<'a> {
-    fn new(origin: &'a str, n_imus: usize) -> Self {
+    fn new(origin: &'a str, n_imus: usize, numbers: AngleNumbers) -> Self {
         Acc {
             origin,
             time: Vec::new(),
@@ -552,6 +557,8 @@ impl<'a> Acc<'a> {
             series: vec![Vec::new(); n_imus],
             gyro: vec![Vec::new(); n_imus],
             renorm: vec![Renorm::default(); n_imus],
+            tally: Tally::default(),
+            numbers,
         }
     }
 
@@ -676,6 +683,7 @@ impl<'a> Acc<'a> {
             time_s: self.time,
             imus,
             warnings,
+            orientation_decimals: self.tally.finish(self.numbers),
         })
     }
 }
@@ -778,7 +786,12 @@ pub(crate) fn parse_rows(
     format: TrialFormat,
     check_axis: bool,
 ) -> Result<Trial, TrialError> {
-    let mut acc = Acc::new(origin, layout.imus.len());
+    let numbers = if format == TrialFormat::EulerCsv {
+        AngleNumbers::EulerDeg
+    } else {
+        AngleNumbers::Quaternion
+    };
+    let mut acc = Acc::new(origin, layout.imus.len(), numbers);
     let ncols = layout.columns.len();
     match format {
         TrialFormat::QuatCsv | TrialFormat::EulerCsv => {
@@ -801,6 +814,7 @@ pub(crate) fn parse_rows(
                 for (k, imu) in layout.imus.iter().enumerate() {
                     for (j, v) in vals.iter_mut().take(group).enumerate() {
                         *v = cell(imu.first_field + j)?;
+                        acc.tally.see(cells[imu.first_field + j].trim_ascii());
                     }
                     if euler {
                         acc.series[k].push(quat_from_euler_zyx_deg([vals[0], vals[1], vals[2]]));
@@ -850,6 +864,7 @@ pub(crate) fn parse_rows(
                             // The column's name is built only for the message.
                             _ => number(part, origin, line, col, &format!("{} {p}", imu.found))?,
                         };
+                        acc.tally.see(part.trim_ascii());
                     }
                     acc.push_quat(k, q, line, col, &imu.found)?;
                 }

@@ -1,6 +1,7 @@
 //! Tests of trial reading and writing: round trips, malformed input, names.
 
 mod gyro;
+mod precision;
 
 use super::*;
 use crate::rotation::{angle_between_deg, quat_from_euler_zyx_deg, quat_from_wxyz, Quat};
@@ -13,7 +14,7 @@ pub(super) fn infant() -> Model {
     Model::infant13()
 }
 
-fn opensim() -> Model {
+pub(super) fn opensim() -> Model {
     Model::builtin("opensim").unwrap()
 }
 
@@ -54,6 +55,7 @@ pub(super) fn random_trial(names: &[&str], n: usize, seed: u64) -> Trial {
         time_s,
         imus,
         warnings: vec![],
+        orientation_decimals: None,
     }
 }
 

@@ -272,3 +272,29 @@ fn what_a_variant_skipped_or_fell_back_to_is_said() {
         "{text}"
     );
 }
+
+/// The workbench saves a six-decimal trial's correction at six decimals.
+#[test]
+fn a_save_keeps_the_inputs_decimals() {
+    use crate::trial::precision::{decimals_of, Precision};
+    use crate::trial::{read_trial, write_trial_hashed, TrialFormat};
+    let fx = Fixture::new();
+    let trials = fx.root().join("trials");
+    let fb = read_trial(&trials.join("fb.csv.gz"), &crate::model::Model::infant13()).unwrap();
+    let six = trials.join("six.csv");
+    write_trial_hashed(&fb, &six, TrialFormat::QuatCsv, Precision::Decimals(6)).unwrap();
+    let mut app = fx.app();
+    app.select_file("six.csv");
+    key(&mut app, KeyCode::Enter);
+    keys(&mut app, "rc");
+    key(&mut app, KeyCode::Char(' '));
+    keys(&mut app, "w");
+    let v = app.open_entry().unwrap().chosen.unwrap();
+    let out = std::fs::read_to_string(trials.join(format!("corrected/six.{v}.csv"))).unwrap();
+    let most = out
+        .lines()
+        .skip(1)
+        .flat_map(|l| l.split(',').skip(1).map(decimals_of).collect::<Vec<_>>())
+        .max();
+    assert_eq!(most, Some(6));
+}
