@@ -62,7 +62,7 @@ pub fn cost_direct(measured: &[Quat], c: &Quat, limits: &JointLimits, lambda1: f
     let sum: f64 = measured
         .iter()
         .map(|qm| {
-            let qt = qm * c;
+            let qt = limits.to_axes(&(qm * c));
             let e: f64 = excursion(euler_zyx_deg(&qt), &limits.range_deg)
                 .iter()
                 .sum();
@@ -402,9 +402,12 @@ const BLOCK: usize = 64;
 /// The cost of one joint over one window, prepared for many evaluations.
 #[derive(Debug, Clone)]
 pub struct WindowCost {
+    /// The measured rotations in the limits' axes (`Q^T Rm_i Q`).
     samples: Samples,
     terms: LimitTerms,
     lambda1: f64,
+    /// The limits' axes: a correction `C` is evaluated as `Q^T C Q`.
+    axes: Option<crate::model::TableAxes>,
 }
 
 impl WindowCost {
@@ -425,12 +428,21 @@ impl WindowCost {
     ) -> Self {
         let mut samples = Samples::default();
         for q in measured {
-            samples.push(q);
+            samples.push(&limits.to_axes(q));
         }
         WindowCost {
             samples,
             terms: LimitTerms::new(limits),
             lambda1,
+            axes: limits.axes,
+        }
+    }
+
+    /// A correction `c` (distal segment frame) in the limits' axes: `Q^T C Q`.
+    fn in_axes(&self, c: &Quat) -> Quat {
+        match &self.axes {
+            Some(a) => a.to_table(c),
+            None => *c,
         }
     }
 
@@ -452,7 +464,7 @@ impl WindowCost {
     /// `e(C)`: mean excursion (plus centroid term) over the samples, plus
     /// `lambda1 * angle(C)`; degrees.
     pub fn eval(&self, c: &Quat) -> f64 {
-        self.data(c, None) + self.lambda1 * angle_deg(c)
+        self.data(&self.in_axes(c), None) + self.lambda1 * angle_deg(c)
     }
 
     /// `e(C)` without its `lambda1 * angle(C)` term (degrees), and that part's
@@ -461,7 +473,11 @@ impl WindowCost {
     /// on a limit or at the centroid) it is the gradient of one side.
     pub fn data_grad(&self, c: &Quat) -> (f64, Vector3<f64>) {
         let mut g = Vector3::zeros();
-        let f = self.data(c, Some(&mut g));
+        let f = self.data(&self.in_axes(c), Some(&mut g));
+        // In the axes `C exp(v)` is `Q^T C Q exp(Q^T v)`: the gradient turns by Q.
+        if let Some(a) = &self.axes {
+            g = a.q * g;
+        }
         (f, g)
     }
 
@@ -598,16 +614,19 @@ mod tests {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         });
         check_fast_equals_direct(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
+            axes: None,
         });
         check_fast_equals_direct(JointLimits {
             range_deg: [[-180.0, 180.0], [-90.0, 90.0], [100.0, 120.0]],
             centroid_deg: Some([0.0, 5.0, 0.0]),
             lambda2: 30.0,
+            axes: None,
         });
     }
 
@@ -656,17 +675,20 @@ mod tests {
                 range_deg: r,
                 centroid_deg: cen,
                 lambda2: if cen.is_some() { 30.0 } else { 0.0 },
+                axes: None,
             });
         }
         check_gradient(JointLimits {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         });
         check_gradient(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
+            axes: None,
         });
     }
 
@@ -677,6 +699,7 @@ mod tests {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         };
         let cost = WindowCost::new(&measured, &limits, 0.05);
         assert_eq!(cost.eval(&Quat::identity()), 0.0);

@@ -74,8 +74,11 @@ impl HeadingCost {
             .zip(child)
             .step_by(stride.max(1))
             .map(|(p, d)| {
-                let b = d * c;
-                let pt = p.inverse();
+                // In the limits' axes `Rt` is `(P Q)^T R_up(-h) (D C Q)`.
+                let (b, pt) = match &limits.axes {
+                    Some(a) => (d * c * a.q, (p * a.q).inverse()),
+                    None => (d * c, p.inverse()),
+                };
                 let pm = pt.to_rotation_matrix().into_inner();
                 let bm = b.to_rotation_matrix().into_inner();
                 let centroid_dots = match centroid {
@@ -171,11 +174,13 @@ mod tests {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         };
         let shoulder = JointLimits {
             range_deg: [[-10.0, 100.0], [-40.0, 60.0], [-70.0, 70.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
+            axes: None,
         };
         check(knee, Vertical::ZUp);
         check(shoulder, Vertical::ZUp);

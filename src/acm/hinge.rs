@@ -305,16 +305,38 @@ fn turn_ranges(hinge: Hinge, rm: &[Quat], a: &Vector3<f64>, b: &Vector3<f64>) ->
             let (np, nd) = hinge.segment_axes();
             let cp = swing(a, &Vector3::from(np));
             let cd_inv = swing(b, &Vector3::from(nd)).inverse();
+            // `R_p(x) R_d(y)` read as Z-Y-X angles: of the segment frames when
+            // `p` comes first in that order, else in the frame `M` whose Z is
+            // `p` and X is `d` (`M^T R M = Rz(x) Ry(0) Rx(y)`).
+            let zyx_first = proximal.index() > distal.index();
+            let m = two_axis_frame(np, nd);
             let angles: Vec<[f64; 3]> = rm
                 .iter()
-                .map(|r| crate::rotation::euler_zyx_deg(&(cp * r * cd_inv)))
+                .map(|r| {
+                    let r = cp * r * cd_inv;
+                    let r = if zyx_first { r } else { m.inverse() * r * m };
+                    crate::rotation::euler_zyx_deg(&r)
+                })
                 .collect();
+            let (kp, kd) = if zyx_first {
+                (proximal.index(), distal.index())
+            } else {
+                (2, 0)
+            };
             (
-                range(&mut angles.iter().map(|e| e[proximal.index()])),
-                range(&mut angles.iter().map(|e| e[distal.index()])),
+                range(&mut angles.iter().map(|e| e[kp])),
+                range(&mut angles.iter().map(|e| e[kd])),
             )
         }
     }
+}
+
+/// The rotation `M` with columns `d`, `p x d`, `p` (unit segment axes `p`
+/// fixed in the proximal and `d` in the distal segment, orthogonal).
+fn two_axis_frame(p: [f64; 3], d: [f64; 3]) -> Quat {
+    let (p, d) = (Vector3::from(p), Vector3::from(d));
+    let m = Matrix3::from_columns(&[d, p.cross(&d), p]);
+    Quat::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(m))
 }
 
 /// The corrections of an IMU whose hinge axis is known:
