@@ -570,6 +570,15 @@ pub(super) fn random_quat(rng: &mut rand_chacha::ChaCha8Rng, max_deg: f64) -> Qu
     crate::rotation::quat_axis_angle_deg(axis, rng.random_range(0.0..max_deg))
 }
 
+/// Limit axes to test the costs in: none, a mirror image (`full_body16`'s
+/// `r_elbow`, `["-y", "-x", "+z"]`) and a proper rotation (its `r_hip`,
+/// `["-z", "-y", "-x"]`) of the segment frames.
+#[cfg(test)]
+pub(super) fn test_axes() -> [Option<crate::model::TableAxes>; 3] {
+    let of = |a: [&str; 3]| crate::model::TableAxes::of(&a.map(|s| s.parse().expect("an axis")));
+    [None, of(["-y", "-x", "+z"]), of(["-z", "-y", "-x"])]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -596,6 +605,12 @@ mod tests {
     }
 
     fn check_fast_equals_direct(limits: JointLimits) {
+        for axes in test_axes() {
+            check_fast_equals_direct_in(JointLimits { axes, ..limits });
+        }
+    }
+
+    fn check_fast_equals_direct_in(limits: JointLimits) {
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let measured: Vec<Quat> = (0..400).map(|_| random_quat(&mut rng, 180.0)).collect();
         let cost = WindowCost::new(&measured, &limits, 0.05);
@@ -631,6 +646,12 @@ mod tests {
     }
 
     fn check_gradient(limits: JointLimits) {
+        for axes in test_axes() {
+            check_gradient_in(JointLimits { axes, ..limits });
+        }
+    }
+
+    fn check_gradient_in(limits: JointLimits) {
         let mut rng = ChaCha8Rng::seed_from_u64(12);
         let measured: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 120.0)).collect();
         let cost = WindowCost::new(&measured, &limits, 0.05);
@@ -705,5 +726,49 @@ mod tests {
         assert_eq!(cost.eval(&Quat::identity()), 0.0);
         let c = quat_axis_angle_deg([0.0, 1.0, 0.0], 10.0);
         assert!((cost.eval(&c) - 0.5).abs() < 1e-9);
+    }
+
+    /// The engine's cost in the table's axes (`JointLimits::in_table_axes`) is
+    /// the cost of the joint's table-convention angles against the table's
+    /// limits and centroid, for joints whose axes are a proper rotation and a
+    /// mirror image of the segment frames.
+    #[test]
+    fn cost_in_table_axes_is_the_cost_of_the_table_angles() {
+        let model = crate::model::Model::builtin("full_body16").unwrap();
+        let table = crate::limits::LimitTable::default_table();
+        let mut rng = ChaCha8Rng::seed_from_u64(13);
+        for name in [
+            "r_elbow",
+            "l_elbow",
+            "r_hip",
+            "r_knee",
+            "l_shoulder",
+            "l_ankle",
+        ] {
+            let j = model.joint(name).unwrap();
+            let mut lim = table.joint_limits(&j.name, &j.kind, true).unwrap();
+            lim.centroid_deg = Some([20.0, -10.0, 35.0]);
+            lim.lambda2 = 30.0;
+            let framed = lim.in_table_axes(j);
+            assert!(framed.axes.is_some());
+            let measured: Vec<Quat> = (0..200).map(|_| random_quat(&mut rng, 180.0)).collect();
+            let cost = WindowCost::new(&measured, &framed, 0.05);
+            let centroid = j.rotation(lim.centroid_deg.unwrap());
+            for _ in 0..20 {
+                let c = random_quat(&mut rng, 60.0);
+                let want: f64 = measured
+                    .iter()
+                    .map(|m| {
+                        let rt = m * c;
+                        let e: f64 = excursion(j.table_angles(&rt), &lim.range_deg).iter().sum();
+                        e + 30.0 * rmsq(&rt, &centroid)
+                    })
+                    .sum::<f64>()
+                    / measured.len() as f64
+                    + 0.05 * angle_deg(&c);
+                let got = cost.eval(&c);
+                assert!((got - want).abs() < 1e-9, "{name}: {got} vs {want}");
+            }
+        }
     }
 }

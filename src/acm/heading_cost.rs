@@ -142,12 +142,18 @@ impl HeadingCost {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acm::cost::{cost_direct, random_quat};
+    use crate::acm::cost::{cost_direct, random_quat, test_axes};
     use crate::vertical::Vertical;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
     fn check(limits: JointLimits, vertical: Vertical) {
+        for axes in test_axes() {
+            check_in(JointLimits { axes, ..limits }, vertical);
+        }
+    }
+
+    fn check_in(limits: JointLimits, vertical: Vertical) {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let parent: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
         let child: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();

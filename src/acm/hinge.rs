@@ -498,4 +498,39 @@ mod tests {
         assert!((s.phi_deg + 123.4).abs() < 1e-6, "{s:?}");
         assert!(s.cost < 1e-6);
     }
+
+    #[test]
+    fn two_axis_turn_ranges_in_any_order_of_the_axes() {
+        use crate::model::Axis;
+        // R = R_p(a) R_d(b): a over 0..40, b over -10..60, for each pair of
+        // axes, the proximal one earlier or later in Z-Y-X order.
+        for (p, d) in [
+            (Axis::Z, Axis::X),
+            (Axis::Z, Axis::Y),
+            (Axis::Y, Axis::X),
+            (Axis::X, Axis::Z),
+            (Axis::Y, Axis::Z),
+            (Axis::X, Axis::Y),
+        ] {
+            let hinge = Hinge::Two {
+                proximal: p,
+                distal: d,
+            };
+            let (np, nd) = hinge.segment_axes();
+            let rm: Vec<Quat> = (0..=20)
+                .map(|i| {
+                    let s = f64::from(i) / 20.0;
+                    let a = 40.0 * s;
+                    let b = -10.0 + 70.0 * (1.0 - s) * (1.0 - s);
+                    quat_axis_angle_deg(np, a) * quat_axis_angle_deg(nd, b)
+                })
+                .collect();
+            let (ra, rb) = turn_ranges(hinge, &rm, &Vector3::from(np), &Vector3::from(nd));
+            assert!(
+                (ra - 40.0).abs() < 1e-9 && (rb - 70.0).abs() < 1e-9,
+                "{}: {ra} {rb}",
+                hinge.name()
+            );
+        }
+    }
 }

@@ -104,11 +104,17 @@ impl ParentCost {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acm::cost::{cost_direct, random_quat};
+    use crate::acm::cost::{cost_direct, random_quat, test_axes};
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
     fn check(limits: JointLimits) {
+        for axes in test_axes() {
+            check_in(JointLimits { axes, ..limits });
+        }
+    }
+
+    fn check_in(limits: JointLimits) {
         let mut rng = ChaCha8Rng::seed_from_u64(8);
         let b: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
         let cost = ParentCost::new(b.iter().copied(), &limits);

@@ -439,4 +439,33 @@ mod tests {
         );
         assert_eq!(one.windows.len(), 1);
     }
+
+    #[test]
+    fn rivest_works_on_the_table_angles_of_a_standing_knee() {
+        // full_body16's right knee counts flexion on the segments' y with
+        // table X and Z on their -z and -x (a mirror image): a calf offset of
+        // 8 deg about the table's X with up to 80 deg of flexion is removed
+        // from X and Z and flexion stays as measured, all in table angles.
+        let model = crate::model::Model::builtin("full_body16").unwrap();
+        let knee = model.joint("r_knee").unwrap();
+        assert_eq!(knee.table_axes().unwrap().det, -1.0);
+        let time_s: Vec<f64> = (0..3000).map(|i| i as f64 / 50.0).collect();
+        let flex = |t: f64| 45.0 - 35.0 * (t * 0.5).cos();
+        let measured: Vec<Quat> = time_s
+            .iter()
+            .map(|&t| knee.rotation([0.0, flex(t), 0.0]) * knee.rotation([8.0, 0.0, 0.0]))
+            .collect();
+        let windows = whole_trial(&time_s);
+        let method = method_for(Variant::Rivest, knee).unwrap();
+        let sol = solve_joint(method, &time_s, &measured, None, &windows);
+        let BaselineRecord::Rivest { fits } = &sol.record else {
+            panic!("rivest record")
+        };
+        assert!((fits[0].b2 - 8.0).abs() < 1e-6, "{:?}", fits[0]);
+        for i in (0..time_s.len()).step_by(101) {
+            let a = knee.table_angles(&(measured[i] * sol.series[i]));
+            assert!(a[0].abs() < 1e-6 && a[2].abs() < 1e-6, "{i}: {a:?}");
+            assert!((a[1] - flex(time_s[i])).abs() < 1e-6, "{i}: {a:?}");
+        }
+    }
 }
