@@ -165,16 +165,23 @@ fn physical_trial(
     mount: &BTreeMap<String, Quat>,
     heading_deg: f64,
 ) -> Trial {
-    let turns: Vec<(&str, Box<dyn Fn(f64) -> Quat + '_>)> = moving
+    let turns: Vec<TurnFn> = moving
         .iter()
-        .map(|&(name, axis, angle)| {
+        .map(|&(_, axis, angle)| {
             let turn = move |t: f64| UnitQuaternion::from_scaled_axis(axis * angle(t).to_radians());
-            (name, Box::new(turn) as Box<dyn Fn(f64) -> Quat>)
+            Box::new(turn) as TurnFn
         })
         .collect();
-    let turns: Vec<Turning> = turns.iter().map(|(n, f)| (*n, f.as_ref())).collect();
+    let turns: Vec<Turning> = moving
+        .iter()
+        .zip(&turns)
+        .map(|((n, _, _), f)| (*n, f.as_ref()))
+        .collect();
     turning_trial(model, &turns, mount, heading_deg)
 }
+
+/// A joint's rotation over time, boxed.
+type TurnFn<'a> = Box<dyn Fn(f64) -> Quat + 'a>;
 
 /// A joint that turns: its name and its rotation over time (pose frame, made
 /// in the proximal segment).
