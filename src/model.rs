@@ -438,8 +438,8 @@ impl Joint {
         }
     }
 
-    /// Which segment-frame Z-Y-X angle the table's `axis` is, and whether it
-    /// counts the other way.
+    /// The segment axis, with its sign, that is the table's `axis`
+    /// (`angle_axes[axis]`): a small turn about it reads positive there.
     pub fn segment_axis(&self, axis: Axis) -> SignedAxis {
         self.angle_axes[axis.index()]
     }
