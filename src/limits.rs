@@ -71,24 +71,43 @@ pub struct JointLimits {
     pub centroid_deg: Option<[f64; 3]>,
     /// Weight of the centroid term (docs/method.md section 5).
     pub lambda2: f64,
+    /// The frame the ranges apply in: `None` for the Z-Y-X angles of the joint
+    /// rotation itself (the table's convention of a joint with identity
+    /// `angle_axes`, and every use outside the engine); `Some(axes)` for those
+    /// of `Q^T R Q` (the engine's costs, [`JointLimits::in_table_axes`]).
+    pub axes: Option<crate::model::TableAxes>,
 }
 
 impl JointLimits {
-    /// The same limits over the Z-Y-X angles of `joint`'s segment frames (the
-    /// angles the engine computes), from the table's convention: each axis'
-    /// range and centroid moved to the segment axis the joint's `angle_axes`
-    /// names, negated (and the range's ends swapped) where it counts the other
-    /// way. The cost of a rotation is the same either way.
-    pub fn in_segment_frames(&self, joint: &crate::model::Joint) -> JointLimits {
-        let mut range_deg = self.range_deg;
-        for (k, a) in joint.angle_axes.iter().enumerate() {
-            let [lo, hi] = self.range_deg[k];
-            range_deg[a.axis.index()] = if a.negative { [-hi, -lo] } else { [lo, hi] };
-        }
+    /// The same limits as the engine's costs apply them to a joint rotation
+    /// `R` of `joint`'s segment frames (docs/method.md section 2.5): on the
+    /// Z-Y-X angles of `Q^T R Q`, which are the table's angles times
+    /// `det(P)`. So the ranges and the centroid are kept (`det(P) = 1`) or
+    /// negated (`det(P) = -1`: `[lo, hi]` becomes `[-hi, -lo]`), and `axes`
+    /// set. With identity `angle_axes` the limits are returned unchanged.
+    pub fn in_table_axes(&self, joint: &crate::model::Joint) -> JointLimits {
+        let Some(axes) = joint.table_axes() else {
+            return *self;
+        };
+        let flip = axes.det < 0.0;
         JointLimits {
-            range_deg,
-            centroid_deg: self.centroid_deg.map(|c| joint.segment_angles(c)),
+            range_deg: self
+                .range_deg
+                .map(|[lo, hi]| if flip { [-hi, -lo] } else { [lo, hi] }),
+            centroid_deg: self
+                .centroid_deg
+                .map(|c| if flip { c.map(|a| -a) } else { c }),
             lambda2: self.lambda2,
+            axes: Some(axes),
+        }
+    }
+
+    /// A joint rotation `r` (segment frames) as the ranges see it: `Q^T R Q`,
+    /// or `r` itself without `axes`.
+    pub fn to_axes(&self, r: &crate::rotation::Quat) -> crate::rotation::Quat {
+        match &self.axes {
+            Some(a) => a.to_table(r),
+            None => *r,
         }
     }
 }
@@ -591,6 +610,7 @@ impl LimitTable {
             range_deg: rows.map(|r| [r.lower_deg, r.upper_deg]),
             centroid_deg: centroid,
             lambda2,
+            axes: None,
         })
     }
 

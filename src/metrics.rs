@@ -181,6 +181,7 @@ mod tests {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         }
     }
 

@@ -184,10 +184,12 @@ fn is_all_axes(v: &[Axis]) -> bool {
 pub enum Hinge {
     /// One axis, fixed in both segments (`"y"` for a knee: flexion only).
     Single(Axis),
-    /// Two segment axes, the third Z-Y-X angle constant: `proximal`, the
-    /// earlier of the two in Z-Y-X order, is fixed in the proximal segment and
-    /// `distal` in the distal one (`"z-x"` for the elbow of frames whose
-    /// carrying angle is Y: pronation and flexion; `"z-y"` where it is X).
+    /// Two segment axes: `proximal` fixed in the proximal segment and `distal`
+    /// in the distal one, `R = R_proximal(a) R_distal(b)` (`"z-x"` for the
+    /// elbow of frames whose carrying angle is Y: pronation and flexion;
+    /// `"z-y"` where it is X). When `proximal` is the earlier of the two in
+    /// Z-Y-X order (`z-y`, `z-x`, `y-x`), the third Z-Y-X angle of the
+    /// segment frames is the constant one.
     Two {
         /// The segment axis fixed in the proximal segment.
         proximal: Axis,
@@ -232,18 +234,17 @@ impl Hinge {
         (unit(p), unit(d))
     }
 
-    /// The name in model files: `x`, `y`, `z`, `z-y`, `z-x` or `y-x`.
+    /// The name in model files: `x`, `y`, `z`, or `<proximal>-<distal>`
+    /// (`z-y`, `z-x`, `y-x`, `y-z`, `x-z`, `x-y`).
     pub fn name(self) -> &'static str {
+        const TWO: [[&str; 3]; 3] = [
+            ["x-x", "x-y", "x-z"],
+            ["y-x", "y-y", "y-z"],
+            ["z-x", "z-y", "z-z"],
+        ];
         match self {
             Hinge::Single(a) => a.name(),
-            Hinge::Two {
-                proximal: Axis::Z,
-                distal: Axis::Y,
-            } => "z-y",
-            Hinge::Two {
-                proximal: Axis::Y, ..
-            } => "y-x",
-            Hinge::Two { .. } => "z-x",
+            Hinge::Two { proximal, distal } => TWO[proximal.index()][distal.index()],
         }
     }
 }
@@ -258,8 +259,16 @@ impl TryFrom<String> for Hinge {
             "z-y" => Ok(Hinge::two_axes_holding(Axis::X)),
             "z-x" => Ok(Hinge::two_axes_holding(Axis::Y)),
             "y-x" => Ok(Hinge::two_axes_holding(Axis::Z)),
+            "y-z" | "x-z" | "x-y" => {
+                let axis = |c: &str| c.parse::<SignedAxis>().map(|a| a.axis);
+                let t = s.trim().to_ascii_lowercase();
+                Ok(Hinge::Two {
+                    proximal: axis(&t[..1])?,
+                    distal: axis(&t[2..])?,
+                })
+            }
             _ => Err(format!(
-                "hinge = '{s}': expected x, y or z (one axis fixed in both segments) or z-y, z-x or y-x (the first fixed in the proximal segment, the second in the distal, the third Z-Y-X angle constant)"
+                "hinge = '{s}': expected x, y or z (one axis fixed in both segments) or two different axes, the first fixed in the proximal segment, the second in the distal (z-y, z-x, y-x, y-z, x-z, x-y)"
             )),
         }
     }
@@ -303,13 +312,16 @@ pub struct Joint {
     /// hinge.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hinge: Option<Hinge>,
-    /// The joint's angles in the limit table's convention (docs/method.md
-    /// section 2.5): entry k names the Z-Y-X angle of the segment frames
-    /// (`x`, `y` or `z` of `(G_R_prox)^T G_R_dist`) that is the table's axis k,
-    /// with its sign: `["-z", "-y", "-x"]` makes the table's X minus the
-    /// segment-frame Z angle, and so on. `["+x", "+y", "+z"]` (the default)
-    /// takes the segment-frame angles as they are. Every joint angle the
-    /// program shows, writes or limits is in the table's convention.
+    /// The limit table's axes (docs/method.md section 2.5): entry k names the
+    /// segment-frame axis, with its sign, that is the table's axis k
+    /// (`["-z", "-y", "-x"]`: the table's X is the segment frames' -z, and so
+    /// on). The joint's angles are the Z-Y-X angles of
+    /// `(G_R_prox)^T G_R_dist` expressed in these axes ([`TableAxes`]), so a
+    /// small turn about segment axis `a_k` reads on table axis k with sign
+    /// `s_k`, and any turn reads in the table's own Z-Y-X order. `["+x", "+y",
+    /// "+z"]` (the default) takes the segment frames' angles as they are.
+    /// Every joint angle the program shows, writes or limits is in the table's
+    /// convention.
     #[serde(default = "identity_axes", skip_serializing_if = "is_identity_axes")]
     pub angle_axes: [SignedAxis; 3],
 }
@@ -338,49 +350,96 @@ fn is_identity_axes(a: &[SignedAxis; 3]) -> bool {
     *a == IDENTITY_AXES
 }
 
-impl Joint {
-    /// Degrees `[x, y, z]` in the limit table's convention from the Z-Y-X
-    /// angles of the segment frames (see [`Joint::angle_axes`]).
-    pub fn table_angles(&self, segment: [f64; 3]) -> [f64; 3] {
-        if is_identity_axes(&self.angle_axes) {
-            return segment;
+/// The limit table's axes in a joint's segment frames (docs/method.md section
+/// 2.5): `P`, the signed permutation whose column k is table axis k in segment
+/// coordinates (`angle_axes[k]`), kept as the proper rotation `Q = det(P) P`
+/// and the sign `det(P)`. The table's angles of a joint rotation `R` (segment
+/// frames) are `det(P) * ZYX(Q^T R Q)`, degrees.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableAxes {
+    /// `Q = det(P) P` as a unit quaternion (a proper rotation).
+    pub q: crate::rotation::Quat,
+    /// `det(P)`: `1.0`, or `-1.0` when the table's axes are a mirror image of
+    /// the segment frames' (the table's angles then count the other way).
+    pub det: f64,
+}
+
+impl TableAxes {
+    /// The axes of `angle_axes`; `None` for the identity (`["+x", "+y", "+z"]`),
+    /// where the table's angles are the segment frames' own.
+    pub fn of(angle_axes: &[SignedAxis; 3]) -> Option<TableAxes> {
+        if is_identity_axes(angle_axes) {
+            return None;
         }
-        self.angle_axes.map(|a| {
-            let v = segment[a.axis.index()];
-            if a.negative {
-                -v
-            } else {
-                v
-            }
+        let cols = angle_axes.map(|a| nalgebra::Vector3::from(a.vector()));
+        let p = nalgebra::Matrix3::from_columns(&cols);
+        let det = p.determinant().signum();
+        let rot = nalgebra::Rotation3::from_matrix_unchecked(p * det);
+        Some(TableAxes {
+            q: crate::rotation::Quat::from_rotation_matrix(&rot),
+            det,
         })
     }
 
-    /// The inverse of [`Joint::table_angles`]: the segment frames' Z-Y-X
-    /// angles, degrees, of table-convention angles.
-    pub fn segment_angles(&self, table: [f64; 3]) -> [f64; 3] {
-        if is_identity_axes(&self.angle_axes) {
-            return table;
+    /// `Q^T R Q`: a joint rotation `r` (segment frames) in the table's axes.
+    pub fn to_table(&self, r: &crate::rotation::Quat) -> crate::rotation::Quat {
+        self.q.inverse() * r * self.q
+    }
+
+    /// `Q R Q^T`: the inverse of [`TableAxes::to_table`].
+    pub fn from_table(&self, r: &crate::rotation::Quat) -> crate::rotation::Quat {
+        self.q * r * self.q.inverse()
+    }
+
+    /// The table's angles `[x, y, z]` (degrees) of the joint rotation `r`.
+    pub fn angles(&self, r: &crate::rotation::Quat) -> [f64; 3] {
+        crate::rotation::euler_zyx_deg(&self.to_table(r)).map(|a| self.det * a)
+    }
+
+    /// The joint rotation (segment frames) whose table angles are `table`
+    /// (degrees): `Q Rzyx(det(P) table) Q^T`.
+    pub fn rotation(&self, table: [f64; 3]) -> crate::rotation::Quat {
+        self.from_table(&crate::rotation::quat_from_euler_zyx_deg(
+            table.map(|a| self.det * a),
+        ))
+    }
+}
+
+impl Joint {
+    /// The table's axes in the segment frames; `None` when they are the
+    /// segment frames' own (`angle_axes` the identity).
+    pub fn table_axes(&self) -> Option<TableAxes> {
+        TableAxes::of(&self.angle_axes)
+    }
+
+    /// Degrees `[x, y, z]` in the limit table's convention of the joint
+    /// rotation `r` (distal segment frame in the proximal one): the Z-Y-X
+    /// angles of `r` expressed in the table's axes (see [`TableAxes`]). With
+    /// identity `angle_axes`, the Z-Y-X angles of `r` itself.
+    pub fn table_angles(&self, r: &crate::rotation::Quat) -> [f64; 3] {
+        match self.table_axes() {
+            Some(t) => t.angles(r),
+            None => crate::rotation::euler_zyx_deg(r),
         }
-        let mut out = [0.0; 3];
-        for (k, a) in self.angle_axes.iter().enumerate() {
-            out[a.axis.index()] = if a.negative { -table[k] } else { table[k] };
-        }
-        out
     }
 
     /// The two axes a two-degree-of-freedom joint (the elbow) turns about, in
-    /// segment frames: the model's `hinge` when it names two axes, else the
-    /// two whose third angle is the table's Y (the elbow's carrying angle,
-    /// constant), wherever `angle_axes` puts it.
+    /// segment frames: the model's `hinge` when it names two axes, else those
+    /// of table angles `[x, 0, z]` (the elbow's carrying angle Y constant):
+    /// `Q Rz Rx Q^T` turns about the segment axis of the table's Z, fixed in
+    /// the proximal segment, and that of its X, fixed in the distal one.
     pub fn two_axis_hinge(&self) -> Hinge {
         match self.hinge {
             Some(h @ Hinge::Two { .. }) => h,
-            _ => Hinge::two_axes_holding(self.segment_axis(Axis::Y).axis),
+            _ => Hinge::Two {
+                proximal: self.segment_axis(Axis::Z).axis,
+                distal: self.segment_axis(Axis::X).axis,
+            },
         }
     }
 
-    /// Which segment-frame Z-Y-X angle the table's `axis` is, and whether it
-    /// counts the other way.
+    /// The segment axis, with its sign, that is the table's `axis`
+    /// (`angle_axes[axis]`): a small turn about it reads positive there.
     pub fn segment_axis(&self, axis: Axis) -> SignedAxis {
         self.angle_axes[axis.index()]
     }
@@ -392,15 +451,16 @@ impl Joint {
         proximal: &crate::rotation::Quat,
         distal: &crate::rotation::Quat,
     ) -> [f64; 3] {
-        self.table_angles(crate::rotation::euler_zyx_deg(
-            &(proximal.inverse() * distal),
-        ))
+        self.table_angles(&(proximal.inverse() * distal))
     }
 
     /// The joint rotation (distal segment frame in the proximal one) whose
     /// angles in the table's convention are `table` (degrees).
     pub fn rotation(&self, table: [f64; 3]) -> crate::rotation::Quat {
-        crate::rotation::quat_from_euler_zyx_deg(self.segment_angles(table))
+        match self.table_axes() {
+            Some(t) => t.rotation(table),
+            None => crate::rotation::quat_from_euler_zyx_deg(table),
+        }
     }
 
     /// Whether inverse kinematics moves this axis.
@@ -979,6 +1039,179 @@ distal = "b"
                 .unwrap_err()
                 .to_string();
             assert!(e.contains("m.toml") && e.contains(want), "{extra}: {e}");
+        }
+    }
+
+    /// The joints of `full_body16` with a proper (`r_hip`) and improper
+    /// (`r_elbow`, `r_knee`) signed permutation, and every other non-identity
+    /// `angle_axes` of the built-in models.
+    fn framed_joints() -> Vec<Joint> {
+        let mut out: Vec<Joint> = Vec::new();
+        for (name, _) in BUILTIN_MODELS {
+            for j in Model::builtin(name).unwrap().joints {
+                let new = !out.iter().any(|o| o.angle_axes == j.angle_axes);
+                if new && !is_identity_axes(&j.angle_axes) {
+                    out.push(j);
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn table_axes_of_the_standing_elbow_hip_and_knee() {
+        let m = Model::builtin("full_body16").unwrap();
+        let det = |n: &str| m.joint(n).unwrap().table_axes().unwrap().det;
+        assert_eq!(
+            m.joint("r_elbow")
+                .unwrap()
+                .angle_axes
+                .map(|a| a.to_string()),
+            ["-y", "-x", "+z"]
+        );
+        assert_eq!(
+            m.joint("r_hip").unwrap().angle_axes.map(|a| a.to_string()),
+            ["-z", "-y", "-x"]
+        );
+        assert_eq!(
+            m.joint("r_knee").unwrap().angle_axes.map(|a| a.to_string()),
+            ["-z", "+y", "-x"]
+        );
+        assert_eq!(
+            (det("r_elbow"), det("r_hip"), det("r_knee")),
+            (-1.0, 1.0, -1.0)
+        );
+        assert_eq!(TableAxes::of(&IDENTITY_AXES), None);
+        // Q takes each segment axis onto its table axis (times det(P)).
+        for j in framed_joints() {
+            let t = j.table_axes().unwrap();
+            for (k, a) in j.angle_axes.iter().enumerate() {
+                let col = t.q * nalgebra::Vector3::from(unit(Axis::ALL[k])) * t.det;
+                let want = nalgebra::Vector3::from(a.vector());
+                assert!((col - want).norm() < 1e-15, "{} {k}", j.name);
+            }
+        }
+    }
+
+    #[test]
+    fn table_angles_round_trip_for_proper_and_improper_axes() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let joints = framed_joints();
+        assert!(joints.len() > 5);
+        for j in &joints {
+            for _ in 0..500 {
+                let t = [
+                    rng.random_range(-179.9..179.9),
+                    rng.random_range(-89.0..89.0),
+                    rng.random_range(-179.9..179.9),
+                ];
+                let back = j.table_angles(&j.rotation(t));
+                for k in 0..3 {
+                    assert!(
+                        (back[k] - t[k]).abs() < 1e-9,
+                        "{} {t:?} -> {back:?}",
+                        j.name
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn small_rotations_read_as_the_signed_permutation_of_the_segment_angles() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
+        for j in framed_joints() {
+            for _ in 0..200 {
+                let e = 0.01; // degrees
+                let seg: [f64; 3] = std::array::from_fn(|_| rng.random_range(-e..e));
+                let r = crate::rotation::quat_from_euler_zyx_deg(seg);
+                // The mapping before section 2.5 took the Z-Y-X angles of the
+                // segment frames, permuted and signed.
+                let old = j.angle_axes.map(|a| {
+                    let v = seg[a.axis.index()];
+                    if a.negative {
+                        -v
+                    } else {
+                        v
+                    }
+                });
+                let new = j.table_angles(&r);
+                for k in 0..3 {
+                    // Equal to first order: they differ by O(e^2) (in degrees,
+                    // e^2 * pi / 180 per product of two angles).
+                    assert!(
+                        (new[k] - old[k]).abs() < 3.0 * e * e * 0.02,
+                        "{}: {new:?} vs {old:?}",
+                        j.name
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn identity_axes_give_the_segment_frames_angles_exactly() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let m = Model::infant13();
+        for j in &m.joints {
+            assert_eq!(j.angle_axes, IDENTITY_AXES);
+            for _ in 0..100 {
+                let t: [f64; 3] = std::array::from_fn(|_| rng.random_range(-170.0..170.0));
+                let p = crate::rotation::quat_from_euler_zyx_deg(t.map(|a| 0.5 * a));
+                let d = crate::rotation::quat_from_euler_zyx_deg(t);
+                let r = p.inverse() * d;
+                assert_eq!(j.angles(&p, &d), crate::rotation::euler_zyx_deg(&r));
+                assert_eq!(j.rotation(t), crate::rotation::quat_from_euler_zyx_deg(t));
+            }
+        }
+    }
+
+    #[test]
+    fn standing_elbow_reads_flexion_beyond_90_degrees() {
+        let m = Model::builtin("full_body16").unwrap();
+        for side in ["r_elbow", "l_elbow"] {
+            let elbow = m.joint(side).unwrap();
+            // Table X (flexion) is the segment axis angle_axes[0] names.
+            let axis = elbow.angle_axes[0].vector();
+            for flex in [30.0, 90.0, 150.0, 160.0] {
+                let r = crate::rotation::quat_axis_angle_deg(axis, flex);
+                let a = elbow.table_angles(&r);
+                assert!(
+                    (a[0] - flex).abs() < 1e-9 && a[1].abs() < 1e-9 && a[2].abs() < 1e-9,
+                    "{side} {flex}: {a:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn two_axis_hinge_turns_about_the_table_z_then_x() {
+        for (name, _) in BUILTIN_MODELS {
+            let m = Model::builtin(name).unwrap();
+            for j in m.joints.iter().filter(|j| j.kind == "elbow") {
+                let Hinge::Two { proximal, distal } = j.two_axis_hinge() else {
+                    panic!("two axes")
+                };
+                let r = j.rotation([40.0, 0.0, 25.0]);
+                let rz = crate::rotation::quat_axis_angle_deg(j.angle_axes[2].vector(), 25.0);
+                let rx = crate::rotation::quat_axis_angle_deg(j.angle_axes[0].vector(), 40.0);
+                assert!(
+                    crate::rotation::angle_between_deg(&r, &(rz * rx)) < 1e-9,
+                    "{name} {}",
+                    j.name
+                );
+                assert_eq!(
+                    (proximal, distal),
+                    (j.angle_axes[2].axis, j.angle_axes[0].axis)
+                );
+            }
+        }
+        for n in ["z-y", "z-x", "y-x", "y-z", "x-z", "x-y"] {
+            let h = Hinge::try_from(n.to_string()).unwrap();
+            assert_eq!(h.name(), n);
         }
     }
 }

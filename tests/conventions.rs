@@ -165,22 +165,50 @@ fn physical_trial(
     mount: &BTreeMap<String, Quat>,
     heading_deg: f64,
 ) -> Trial {
+    let turns: Vec<TurnFn> = moving
+        .iter()
+        .map(|&(_, axis, angle)| {
+            let turn = move |t: f64| UnitQuaternion::from_scaled_axis(axis * angle(t).to_radians());
+            Box::new(turn) as TurnFn
+        })
+        .collect();
+    let turns: Vec<Turning> = moving
+        .iter()
+        .zip(&turns)
+        .map(|((n, _, _), f)| (*n, f.as_ref()))
+        .collect();
+    turning_trial(model, &turns, mount, heading_deg)
+}
+
+/// A joint's rotation over time, boxed.
+type TurnFn<'a> = Box<dyn Fn(f64) -> Quat + 'a>;
+
+/// A joint that turns: its name and its rotation over time (pose frame, made
+/// in the proximal segment).
+type Turning<'a> = (&'a str, &'a dyn Fn(f64) -> Quat);
+
+/// As [`physical_trial`], each joint of `turning` turning its distal segment
+/// by any rotation over time.
+fn turning_trial(
+    model: &Model,
+    turning: &[Turning],
+    mount: &BTreeMap<String, Quat>,
+    heading_deg: f64,
+) -> Trial {
     let time_s: Vec<f64> = (0..400).map(|i| f64::from(i) / 50.0).collect();
     let heading = quat_axis_angle_deg([0.0, 0.0, 1.0], heading_deg);
     let mut seg: BTreeMap<&str, Vec<Quat>> = BTreeMap::new();
     seg.insert(&model.base, vec![Quat::identity(); time_s.len()]);
     for j in &model.joints {
         let parent = seg[j.proximal.as_str()].clone();
-        let turn = moving.iter().find(|(n, _, _)| *n == j.name);
+        let turn = turning.iter().find(|(n, _)| *n == j.name);
         let own: Vec<Quat> = parent
             .iter()
             .zip(&time_s)
             .map(|(p, &t)| match turn {
-                // The turn about a pose-frame axis, made in the proximal
-                // segment (identity in the pose), carried by the parent.
-                Some((_, axis, angle)) => {
-                    p * UnitQuaternion::from_scaled_axis(axis * angle(t).to_radians())
-                }
+                // The turn in the pose frame, made in the proximal segment
+                // (identity in the pose), carried by the parent.
+                Some((_, rotation)) => p * rotation(t),
                 None => *p,
             })
             .collect();
@@ -247,6 +275,102 @@ fn every_movement_of_every_standing_model_reads_positive_on_its_table_axis() {
         }
     }
     assert_eq!(checked, 3 * (7 + 11 + 15));
+}
+
+/// Asserts that `joint` of the calibrated `cal` reads `want(t)` (table
+/// convention, degrees) at every sample to 1e-6 deg.
+fn assert_reads(cal: &Trial, joint: &Joint, what: &str, want: &dyn Fn(f64) -> [f64; 3]) {
+    let a = joint_angles(cal, joint).unwrap();
+    for (i, (x, &t)) in a.iter().zip(&cal.time_s).enumerate() {
+        let w = want(t);
+        for k in 0..3 {
+            assert!(
+                (x[k] - w[k]).abs() < 1e-6,
+                "{} {what}: sample {i}, axis {k}: {:.6} deg, want {:.6} (all {x:?}, want {w:?})",
+                joint.name,
+                x[k],
+                w[k]
+            );
+        }
+    }
+}
+
+/// Large movements read on their table axis too: elbow flexion to 150 deg,
+/// shoulder flexion to 120 deg, hip flexion to 85 deg (hip and knee flexion
+/// are the middle Z-Y-X angle in the table's axes, so they read up to 90).
+#[test]
+fn large_movements_read_on_their_table_axis() {
+    let mut rng = ChaCha8Rng::seed_from_u64(16);
+    let mut checked = 0;
+    for name in ["opensim", "full_body16"] {
+        let model = Model::builtin(name).unwrap();
+        let mount = mountings(&model, &mut rng);
+        for (kind, table_axis, peak) in [
+            ("elbow", 0, 150.0),
+            ("shoulder", 0, 120.0),
+            ("hip", 1, 85.0),
+        ] {
+            for joint in model.joints.iter().filter(|j| j.kind == kind) {
+                let mv = &standing_movements(joint)[table_axis];
+                let angle = |t: f64| swing(t, peak);
+                let heading = rng.random_range(-180.0..180.0);
+                let trial =
+                    physical_trial(&model, &[(&joint.name, mv.axis, &angle)], &mount, heading);
+                let cal = calibrated(&trial, &model);
+                let want = |t: f64| {
+                    let mut w = [0.0; 3];
+                    w[table_axis] = angle(t);
+                    w
+                };
+                assert_reads(&cal, joint, &format!("{name} {} {peak}", mv.name), &want);
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 12);
+}
+
+/// Movements on all three axes at once read back the table-convention Z-Y-X
+/// angles they were made of: the joint turns by
+/// `R_Z(z) R_Y(y) R_X(x)` about the anatomical axes of its table's Z, Y and X
+/// (from the movements' definitions, as above), e.g. elbow flexion 120 with
+/// pronation 40, hip flexion 60 with abduction 20 and external rotation 15.
+#[test]
+fn combined_movements_read_back_their_table_angles() {
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let cases: [(&str, [f64; 3]); 7] = [
+        ("elbow", [120.0, 0.0, 40.0]),
+        ("elbow", [150.0, 5.0, -30.0]),
+        ("hip", [15.0, 60.0, 20.0]),
+        ("knee", [-10.0, 75.0, 5.0]),
+        ("shoulder", [100.0, 30.0, 40.0]),
+        ("ankle", [10.0, 30.0, -10.0]),
+        ("back", [20.0, 40.0, 15.0]),
+    ];
+    let mut checked = 0;
+    for name in ["opensense_lower", "opensim", "full_body16"] {
+        let model = Model::builtin(name).unwrap();
+        let mount = mountings(&model, &mut rng);
+        for (kind, peak) in cases {
+            for joint in model.joints.iter().filter(|j| j.kind == kind) {
+                let mv = standing_movements(joint);
+                let at = move |t: f64| peak.map(|p| swing(t, p));
+                let turn = |t: f64| {
+                    let [x, y, z] = at(t);
+                    let r = |k: usize, a: f64| {
+                        UnitQuaternion::from_scaled_axis(mv[k].axis * a.to_radians())
+                    };
+                    r(2, z) * r(1, y) * r(0, x)
+                };
+                let heading = rng.random_range(-180.0..180.0);
+                let trial = turning_trial(&model, &[(&joint.name, &turn)], &mount, heading);
+                let cal = calibrated(&trial, &model);
+                assert_reads(&cal, joint, &format!("{name} {peak:?}"), &at);
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 20, "{checked}");
 }
 
 /// Gait on the standing models: hips and knees flexing (and the ankles

@@ -326,11 +326,12 @@ fn plan_joints(
                 reason,
             }),
             None => {
-                // The engine works on the segment frames' Z-Y-X angles.
+                // The engine's costs read the joint rotations in the
+                // table's axes (docs/method.md section 2.5).
                 let lim = limits
                     .joint_limits(&joint.name, &joint.kind, variant.centroid())
                     .expect("checked by skip_reason")
-                    .in_segment_frames(joint);
+                    .in_table_axes(joint);
                 todo.push((k, lim));
             }
         }

@@ -62,7 +62,7 @@ pub fn cost_direct(measured: &[Quat], c: &Quat, limits: &JointLimits, lambda1: f
     let sum: f64 = measured
         .iter()
         .map(|qm| {
-            let qt = qm * c;
+            let qt = limits.to_axes(&(qm * c));
             let e: f64 = excursion(euler_zyx_deg(&qt), &limits.range_deg)
                 .iter()
                 .sum();
@@ -402,9 +402,12 @@ const BLOCK: usize = 64;
 /// The cost of one joint over one window, prepared for many evaluations.
 #[derive(Debug, Clone)]
 pub struct WindowCost {
+    /// The measured rotations in the limits' axes (`Q^T Rm_i Q`).
     samples: Samples,
     terms: LimitTerms,
     lambda1: f64,
+    /// The limits' axes: a correction `C` is evaluated as `Q^T C Q`.
+    axes: Option<crate::model::TableAxes>,
 }
 
 impl WindowCost {
@@ -425,12 +428,21 @@ impl WindowCost {
     ) -> Self {
         let mut samples = Samples::default();
         for q in measured {
-            samples.push(q);
+            samples.push(&limits.to_axes(q));
         }
         WindowCost {
             samples,
             terms: LimitTerms::new(limits),
             lambda1,
+            axes: limits.axes,
+        }
+    }
+
+    /// A correction `c` (distal segment frame) in the limits' axes: `Q^T C Q`.
+    fn in_axes(&self, c: &Quat) -> Quat {
+        match &self.axes {
+            Some(a) => a.to_table(c),
+            None => *c,
         }
     }
 
@@ -452,7 +464,7 @@ impl WindowCost {
     /// `e(C)`: mean excursion (plus centroid term) over the samples, plus
     /// `lambda1 * angle(C)`; degrees.
     pub fn eval(&self, c: &Quat) -> f64 {
-        self.data(c, None) + self.lambda1 * angle_deg(c)
+        self.data(&self.in_axes(c), None) + self.lambda1 * angle_deg(c)
     }
 
     /// `e(C)` without its `lambda1 * angle(C)` term (degrees), and that part's
@@ -461,7 +473,11 @@ impl WindowCost {
     /// on a limit or at the centroid) it is the gradient of one side.
     pub fn data_grad(&self, c: &Quat) -> (f64, Vector3<f64>) {
         let mut g = Vector3::zeros();
-        let f = self.data(c, Some(&mut g));
+        let f = self.data(&self.in_axes(c), Some(&mut g));
+        // In the axes `C exp(v)` is `Q^T C Q exp(Q^T v)`: the gradient turns by Q.
+        if let Some(a) = &self.axes {
+            g = a.q * g;
+        }
         (f, g)
     }
 
@@ -554,6 +570,15 @@ pub(super) fn random_quat(rng: &mut rand_chacha::ChaCha8Rng, max_deg: f64) -> Qu
     crate::rotation::quat_axis_angle_deg(axis, rng.random_range(0.0..max_deg))
 }
 
+/// Limit axes to test the costs in: none, a mirror image (`full_body16`'s
+/// `r_elbow`, `["-y", "-x", "+z"]`) and a proper rotation (its `r_hip`,
+/// `["-z", "-y", "-x"]`) of the segment frames.
+#[cfg(test)]
+pub(super) fn test_axes() -> [Option<crate::model::TableAxes>; 3] {
+    let of = |a: [&str; 3]| crate::model::TableAxes::of(&a.map(|s| s.parse().expect("an axis")));
+    [None, of(["-y", "-x", "+z"]), of(["-z", "-y", "-x"])]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -580,6 +605,12 @@ mod tests {
     }
 
     fn check_fast_equals_direct(limits: JointLimits) {
+        for axes in test_axes() {
+            check_fast_equals_direct_in(JointLimits { axes, ..limits });
+        }
+    }
+
+    fn check_fast_equals_direct_in(limits: JointLimits) {
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let measured: Vec<Quat> = (0..400).map(|_| random_quat(&mut rng, 180.0)).collect();
         let cost = WindowCost::new(&measured, &limits, 0.05);
@@ -598,20 +629,29 @@ mod tests {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         });
         check_fast_equals_direct(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
+            axes: None,
         });
         check_fast_equals_direct(JointLimits {
             range_deg: [[-180.0, 180.0], [-90.0, 90.0], [100.0, 120.0]],
             centroid_deg: Some([0.0, 5.0, 0.0]),
             lambda2: 30.0,
+            axes: None,
         });
     }
 
     fn check_gradient(limits: JointLimits) {
+        for axes in test_axes() {
+            check_gradient_in(JointLimits { axes, ..limits });
+        }
+    }
+
+    fn check_gradient_in(limits: JointLimits) {
         let mut rng = ChaCha8Rng::seed_from_u64(12);
         let measured: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 120.0)).collect();
         let cost = WindowCost::new(&measured, &limits, 0.05);
@@ -656,17 +696,20 @@ mod tests {
                 range_deg: r,
                 centroid_deg: cen,
                 lambda2: if cen.is_some() { 30.0 } else { 0.0 },
+                axes: None,
             });
         }
         check_gradient(JointLimits {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         });
         check_gradient(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
+            axes: None,
         });
     }
 
@@ -677,10 +720,55 @@ mod tests {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         };
         let cost = WindowCost::new(&measured, &limits, 0.05);
         assert_eq!(cost.eval(&Quat::identity()), 0.0);
         let c = quat_axis_angle_deg([0.0, 1.0, 0.0], 10.0);
         assert!((cost.eval(&c) - 0.5).abs() < 1e-9);
+    }
+
+    /// The engine's cost in the table's axes (`JointLimits::in_table_axes`) is
+    /// the cost of the joint's table-convention angles against the table's
+    /// limits and centroid, for joints whose axes are a proper rotation and a
+    /// mirror image of the segment frames.
+    #[test]
+    fn cost_in_table_axes_is_the_cost_of_the_table_angles() {
+        let model = crate::model::Model::builtin("full_body16").unwrap();
+        let table = crate::limits::LimitTable::default_table();
+        let mut rng = ChaCha8Rng::seed_from_u64(13);
+        for name in [
+            "r_elbow",
+            "l_elbow",
+            "r_hip",
+            "r_knee",
+            "l_shoulder",
+            "l_ankle",
+        ] {
+            let j = model.joint(name).unwrap();
+            let mut lim = table.joint_limits(&j.name, &j.kind, true).unwrap();
+            lim.centroid_deg = Some([20.0, -10.0, 35.0]);
+            lim.lambda2 = 30.0;
+            let framed = lim.in_table_axes(j);
+            assert!(framed.axes.is_some());
+            let measured: Vec<Quat> = (0..200).map(|_| random_quat(&mut rng, 180.0)).collect();
+            let cost = WindowCost::new(&measured, &framed, 0.05);
+            let centroid = j.rotation(lim.centroid_deg.unwrap());
+            for _ in 0..20 {
+                let c = random_quat(&mut rng, 60.0);
+                let want: f64 = measured
+                    .iter()
+                    .map(|m| {
+                        let rt = m * c;
+                        let e: f64 = excursion(j.table_angles(&rt), &lim.range_deg).iter().sum();
+                        e + 30.0 * rmsq(&rt, &centroid)
+                    })
+                    .sum::<f64>()
+                    / measured.len() as f64
+                    + 0.05 * angle_deg(&c);
+                let got = cost.eval(&c);
+                assert!((got - want).abs() < 1e-9, "{name}: {got} vs {want}");
+            }
+        }
     }
 }

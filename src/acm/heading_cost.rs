@@ -74,8 +74,11 @@ impl HeadingCost {
             .zip(child)
             .step_by(stride.max(1))
             .map(|(p, d)| {
-                let b = d * c;
-                let pt = p.inverse();
+                // In the limits' axes `Rt` is `(P Q)^T R_up(-h) (D C Q)`.
+                let (b, pt) = match &limits.axes {
+                    Some(a) => (d * c * a.q, (p * a.q).inverse()),
+                    None => (d * c, p.inverse()),
+                };
                 let pm = pt.to_rotation_matrix().into_inner();
                 let bm = b.to_rotation_matrix().into_inner();
                 let centroid_dots = match centroid {
@@ -139,12 +142,18 @@ impl HeadingCost {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acm::cost::{cost_direct, random_quat};
+    use crate::acm::cost::{cost_direct, random_quat, test_axes};
     use crate::vertical::Vertical;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
     fn check(limits: JointLimits, vertical: Vertical) {
+        for axes in test_axes() {
+            check_in(JointLimits { axes, ..limits }, vertical);
+        }
+    }
+
+    fn check_in(limits: JointLimits, vertical: Vertical) {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let parent: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
         let child: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
@@ -171,11 +180,13 @@ mod tests {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         };
         let shoulder = JointLimits {
             range_deg: [[-10.0, 100.0], [-40.0, 60.0], [-70.0, 70.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
+            axes: None,
         };
         check(knee, Vertical::ZUp);
         check(shoulder, Vertical::ZUp);

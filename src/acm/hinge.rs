@@ -305,16 +305,38 @@ fn turn_ranges(hinge: Hinge, rm: &[Quat], a: &Vector3<f64>, b: &Vector3<f64>) ->
             let (np, nd) = hinge.segment_axes();
             let cp = swing(a, &Vector3::from(np));
             let cd_inv = swing(b, &Vector3::from(nd)).inverse();
+            // `R_p(x) R_d(y)` read as Z-Y-X angles: of the segment frames when
+            // `p` comes first in that order, else in the frame `M` whose Z is
+            // `p` and X is `d` (`M^T R M = Rz(x) Ry(0) Rx(y)`).
+            let zyx_first = proximal.index() > distal.index();
+            let m = two_axis_frame(np, nd);
             let angles: Vec<[f64; 3]> = rm
                 .iter()
-                .map(|r| crate::rotation::euler_zyx_deg(&(cp * r * cd_inv)))
+                .map(|r| {
+                    let r = cp * r * cd_inv;
+                    let r = if zyx_first { r } else { m.inverse() * r * m };
+                    crate::rotation::euler_zyx_deg(&r)
+                })
                 .collect();
+            let (kp, kd) = if zyx_first {
+                (proximal.index(), distal.index())
+            } else {
+                (2, 0)
+            };
             (
-                range(&mut angles.iter().map(|e| e[proximal.index()])),
-                range(&mut angles.iter().map(|e| e[distal.index()])),
+                range(&mut angles.iter().map(|e| e[kp])),
+                range(&mut angles.iter().map(|e| e[kd])),
             )
         }
     }
+}
+
+/// The rotation `M` with columns `d`, `p x d`, `p` (unit segment axes `p`
+/// fixed in the proximal and `d` in the distal segment, orthogonal).
+fn two_axis_frame(p: [f64; 3], d: [f64; 3]) -> Quat {
+    let (p, d) = (Vector3::from(p), Vector3::from(d));
+    let m = Matrix3::from_columns(&[d, p.cross(&d), p]);
+    Quat::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(m))
 }
 
 /// The corrections of an IMU whose hinge axis is known:
@@ -475,5 +497,40 @@ mod tests {
         let s = minimise_about_axis(&cost, &fam);
         assert!((s.phi_deg + 123.4).abs() < 1e-6, "{s:?}");
         assert!(s.cost < 1e-6);
+    }
+
+    #[test]
+    fn two_axis_turn_ranges_in_any_order_of_the_axes() {
+        use crate::model::Axis;
+        // R = R_p(a) R_d(b): a over 0..40, b over -10..60, for each pair of
+        // axes, the proximal one earlier or later in Z-Y-X order.
+        for (p, d) in [
+            (Axis::Z, Axis::X),
+            (Axis::Z, Axis::Y),
+            (Axis::Y, Axis::X),
+            (Axis::X, Axis::Z),
+            (Axis::Y, Axis::Z),
+            (Axis::X, Axis::Y),
+        ] {
+            let hinge = Hinge::Two {
+                proximal: p,
+                distal: d,
+            };
+            let (np, nd) = hinge.segment_axes();
+            let rm: Vec<Quat> = (0..=20)
+                .map(|i| {
+                    let s = f64::from(i) / 20.0;
+                    let a = 40.0 * s;
+                    let b = -10.0 + 70.0 * (1.0 - s) * (1.0 - s);
+                    quat_axis_angle_deg(np, a) * quat_axis_angle_deg(nd, b)
+                })
+                .collect();
+            let (ra, rb) = turn_ranges(hinge, &rm, &Vector3::from(np), &Vector3::from(nd));
+            assert!(
+                (ra - 40.0).abs() < 1e-9 && (rb - 70.0).abs() < 1e-9,
+                "{}: {ra} {rb}",
+                hinge.name()
+            );
+        }
     }
 }

@@ -30,14 +30,18 @@ struct Sample {
 /// A child joint's window cost as a function of the proximal IMU's correction.
 #[derive(Debug, Clone)]
 pub struct ParentCost {
+    /// The factors `B_i` in the limits' axes (`Q^T B_i Q`).
     samples: Vec<Sample>,
     terms: LimitTerms,
+    /// The child joint's limit axes: `C_p` is evaluated as `Q^T C_p Q`.
+    axes: Option<crate::model::TableAxes>,
 }
 
 impl ParentCost {
     /// Prepares the cost for the fixed right factors `B_i` (see the module docs).
     pub fn new(b: impl Iterator<Item = Quat>, limits: &JointLimits) -> Self {
         let samples = b
+            .map(|q| limits.to_axes(&q))
             .map(|q| {
                 let [col0, col1, col2] = matrix_vectors(&q, false);
                 Sample {
@@ -51,6 +55,7 @@ impl ParentCost {
         ParentCost {
             samples,
             terms: LimitTerms::new(limits),
+            axes: limits.axes,
         }
     }
 
@@ -70,6 +75,11 @@ impl ParentCost {
         if self.samples.is_empty() {
             return 0.0;
         }
+        // In the limits' axes `Rt` is `(Q^T C_p Q)^T (Q^T B Q)`.
+        let c_p = &match &self.axes {
+            Some(a) => a.to_table(c_p),
+            None => *c_p,
+        };
         // Rows of C_p^T are the columns of C_p.
         let [row0, row1, row2] = matrix_vectors(c_p, false);
         let mut sum = 0.0;
@@ -94,11 +104,17 @@ impl ParentCost {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acm::cost::{cost_direct, random_quat};
+    use crate::acm::cost::{cost_direct, random_quat, test_axes};
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
     fn check(limits: JointLimits) {
+        for axes in test_axes() {
+            check_in(JointLimits { axes, ..limits });
+        }
+    }
+
+    fn check_in(limits: JointLimits) {
         let mut rng = ChaCha8Rng::seed_from_u64(8);
         let b: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
         let cost = ParentCost::new(b.iter().copied(), &limits);
@@ -117,11 +133,13 @@ mod tests {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
+            axes: None,
         });
         check(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
+            axes: None,
         });
     }
 }

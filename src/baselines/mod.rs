@@ -18,7 +18,7 @@
 pub mod mueller;
 pub mod rivest;
 
-use crate::model::{Hinge, Joint};
+use crate::model::{Hinge, Joint, SignedAxis, TableAxes};
 use crate::rotation::{angle_deg, canonical, euler_zyx_deg, quat_from_euler_zyx_deg, wxyz, Quat};
 use crate::run::WindowSolution;
 use crate::variant::Variant;
@@ -33,8 +33,12 @@ use serde::{Deserialize, Serialize};
 /// A baseline method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
-    /// Rivest (2005), for joints of kind `knee`.
-    Rivest,
+    /// Rivest (2005), for joints of kind `knee`, on the joint's angles in the
+    /// table's convention (its `angle_axes`, docs/method.md section 2.5).
+    Rivest {
+        /// The joint's [`Joint::angle_axes`].
+        angle_axes: [SignedAxis; 3],
+    },
     /// Mueller et al. (2017), for joints of kind `elbow`, turning about the
     /// two segment axes `axes` ([`Joint::two_axis_hinge`]).
     Mueller {
@@ -47,7 +51,7 @@ impl Method {
     /// The joint kind (limit-table row) the method is made for.
     pub fn joint_kind(self) -> &'static str {
         match self {
-            Method::Rivest => "knee",
+            Method::Rivest { .. } => "knee",
             Method::Mueller { .. } => "elbow",
         }
     }
@@ -56,7 +60,9 @@ impl Method {
 /// The baseline that corrects `joint` in `variant`, if any (by its kind).
 pub fn method_for(variant: Variant, joint: &Joint) -> Option<Method> {
     let m = match variant {
-        Variant::Rivest => Method::Rivest,
+        Variant::Rivest => Method::Rivest {
+            angle_axes: joint.angle_axes,
+        },
         Variant::Mueller => Method::Mueller {
             axes: joint.two_axis_hinge(),
         },
@@ -138,13 +144,31 @@ pub fn solve_joint(
     windows: &[Window],
 ) -> BaselineSolution {
     match method {
-        Method::Rivest => solve_rivest(time_s, measured, windows),
+        Method::Rivest { angle_axes } => solve_rivest(time_s, measured, windows, angle_axes),
         Method::Mueller { axes } => solve_mueller(time_s, measured, gyros, windows, axes),
     }
 }
 
-fn solve_rivest(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> BaselineSolution {
-    let angles: Vec<[f64; 3]> = measured.iter().map(euler_zyx_deg).collect();
+/// Rivest on the table-convention angles of `measured` (docs/method.md
+/// section 2.5): fitted, corrected, and turned back into joint rotations.
+fn solve_rivest(
+    time_s: &[f64],
+    measured: &[Quat],
+    windows: &[Window],
+    angle_axes: [SignedAxis; 3],
+) -> BaselineSolution {
+    let axes = TableAxes::of(&angle_axes);
+    let angles: Vec<[f64; 3]> = measured
+        .iter()
+        .map(|q| match &axes {
+            Some(a) => a.angles(q),
+            None => euler_zyx_deg(q),
+        })
+        .collect();
+    let rotation = |t: [f64; 3]| match &axes {
+        Some(a) => a.rotation(t),
+        None => quat_from_euler_zyx_deg(t),
+    };
     let fits: Vec<RivestFit> = windows
         .iter()
         .map(|w| rivest::fit(&angles[w.first..w.end]))
@@ -155,7 +179,7 @@ fn solve_rivest(time_s: &[f64], measured: &[Quat], windows: &[Window]) -> Baseli
         .iter()
         .zip(&angles)
         .zip(&per_sample)
-        .map(|((rm, a), f)| rm.inverse() * quat_from_euler_zyx_deg(f.correct(*a)))
+        .map(|((rm, a), f)| rm.inverse() * rotation(f.correct(*a)))
         .collect();
     let windows_out = windows
         .iter()
@@ -288,7 +312,7 @@ fn mean_rotation(qs: &[Quat]) -> Quat {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Axis;
+    use crate::model::{Axis, IDENTITY_AXES};
     use crate::rotation::quat_axis_angle_deg;
     use crate::window::{layout, whole_trial};
 
@@ -328,7 +352,12 @@ mod tests {
             proximal: Axis::Z,
             distal: Axis::X,
         };
-        assert_eq!(method_for(Variant::Rivest, knee), Some(Method::Rivest));
+        assert_eq!(
+            method_for(Variant::Rivest, knee),
+            Some(Method::Rivest {
+                angle_axes: knee.angle_axes
+            })
+        );
         assert_eq!(method_for(Variant::Rivest, elbow), None);
         assert_eq!(
             method_for(Variant::Mueller, elbow),
@@ -377,7 +406,15 @@ mod tests {
             })
             .collect();
         let windows = layout(&time_s, 60.0, 30.0);
-        let sol = solve_joint(Method::Rivest, &time_s, &measured, None, &windows);
+        let sol = solve_joint(
+            Method::Rivest {
+                angle_axes: IDENTITY_AXES,
+            },
+            &time_s,
+            &measured,
+            None,
+            &windows,
+        );
         let BaselineRecord::Rivest { fits } = &sol.record else {
             panic!("rivest record")
         };
@@ -392,12 +429,43 @@ mod tests {
         let mid = fits[2].lerp(&fits[3], 0.5);
         assert!((mid.b2 - 0.5 * (fits[2].b2 + fits[3].b2)).abs() < 1e-12);
         let one = solve_joint(
-            Method::Rivest,
+            Method::Rivest {
+                angle_axes: IDENTITY_AXES,
+            },
             &time_s,
             &measured,
             None,
             &whole_trial(&time_s),
         );
         assert_eq!(one.windows.len(), 1);
+    }
+
+    #[test]
+    fn rivest_works_on_the_table_angles_of_a_standing_knee() {
+        // full_body16's right knee counts flexion on the segments' y with
+        // table X and Z on their -z and -x (a mirror image): a calf offset of
+        // 8 deg about the table's X with up to 80 deg of flexion is removed
+        // from X and Z and flexion stays as measured, all in table angles.
+        let model = crate::model::Model::builtin("full_body16").unwrap();
+        let knee = model.joint("r_knee").unwrap();
+        assert_eq!(knee.table_axes().unwrap().det, -1.0);
+        let time_s: Vec<f64> = (0..3000).map(|i| i as f64 / 50.0).collect();
+        let flex = |t: f64| 45.0 - 35.0 * (t * 0.5).cos();
+        let measured: Vec<Quat> = time_s
+            .iter()
+            .map(|&t| knee.rotation([0.0, flex(t), 0.0]) * knee.rotation([8.0, 0.0, 0.0]))
+            .collect();
+        let windows = whole_trial(&time_s);
+        let method = method_for(Variant::Rivest, knee).unwrap();
+        let sol = solve_joint(method, &time_s, &measured, None, &windows);
+        let BaselineRecord::Rivest { fits } = &sol.record else {
+            panic!("rivest record")
+        };
+        assert!((fits[0].b2 - 8.0).abs() < 1e-6, "{:?}", fits[0]);
+        for i in (0..time_s.len()).step_by(101) {
+            let a = knee.table_angles(&(measured[i] * sol.series[i]));
+            assert!(a[0].abs() < 1e-6 && a[2].abs() < 1e-6, "{i}: {a:?}");
+            assert!((a[1] - flex(time_s[i])).abs() < 1e-6, "{i}: {a:?}");
+        }
     }
 }

@@ -2,12 +2,14 @@
 //! each joint's moving Z-Y-X axes as coordinates with their hard limits.
 //!
 //! Segment orientations (segment frame to global frame G):
-//! `S_base = B` (a free rotation), `S_distal = S_proximal * Rz(z) Ry(y) Rx(x)`,
+//! `S_base = B` (a free rotation),
+//! `S_distal = S_proximal * Q Rz(d z) Ry(d y) Rx(d x) Q^T` (the joint's
+//! [`crate::model::Joint::rotation`]: `Q` and `d = det(P)` are its table axes,
+//! docs/method.md section 2.5; `Q = I`, `d = 1` for identity `angle_axes`),
 //! where each of `x, y, z` is a coordinate when the joint declares it in `dof`
 //! and its `default_pose_deg` value otherwise (coordinates, `dof`, hard limits
-//! and the default pose are in the table's convention, each landing on the
-//! segment axis the joint's `angle_axes` names, with its sign). Coordinates are radians inside
-//! the solver, degrees in every output.
+//! and the default pose are in the table's convention). Coordinates are
+//! radians inside the solver, degrees in every output.
 
 use crate::model::{Axis, Model};
 use crate::run::SkippedJoint;
@@ -43,13 +45,16 @@ pub struct Segment {
     pub imu: String,
     /// Index of the parent segment (None for the base).
     pub parent: Option<usize>,
-    /// Per Z-Y-X angle `[x, y, z]` of the segment frames: the coordinate
-    /// index, or None when fixed. A coordinate is a joint angle in the table's
-    /// convention (`angle_axes`), so it lands on its segment axis with `sign`.
+    /// Per table-convention angle `[x, y, z]` of the joint: the coordinate
+    /// index, or None when fixed.
     pub coordinate: [Option<usize>; 3],
-    /// Per segment axis: -1 where the coordinate counts the other way.
-    pub sign: [f64; 3],
-    /// Values of the segment-frame angles, radians (from `default_pose_deg`).
+    /// The joint's table axes `Q` in its segment frames (identity for the
+    /// base and for identity `angle_axes`).
+    pub frame: crate::rotation::Quat,
+    /// `det(P)` of the table axes: -1 where they are a mirror image of the
+    /// segment frames (the Z-Y-X angles of `Q^T R Q` count the other way).
+    pub det: f64,
+    /// Values of the table-convention angles, radians (from `default_pose_deg`).
     pub fixed: [f64; 3],
     /// Weight of this IMU's orientation error.
     pub weight: f64,
@@ -81,7 +86,8 @@ impl Skeleton {
             imu: model.base.clone(),
             parent: None,
             coordinate: [None; 3],
-            sign: [1.0; 3],
+            frame: crate::rotation::Quat::identity(),
+            det: 1.0,
             fixed: [0.0; 3],
             weight: model.weight(&model.base),
             columns: (0..BASE_COLUMNS).collect(),
@@ -110,18 +116,13 @@ impl Skeleton {
             let parent = parent.expect("checked above");
             let mut columns = segments[parent].columns.clone();
             let mut coordinate = [None; 3];
-            let mut sign = [1.0; 3];
             for axis in Axis::ALL.into_iter().filter(|a| j.moves(*a)) {
                 let [lower, upper] = j
                     .hard_limits_deg
                     .get(axis)
                     .map(|l| l.map(f64::to_radians))
                     .unwrap_or([f64::NEG_INFINITY, f64::INFINITY]);
-                let on = j.segment_axis(axis);
-                coordinate[on.axis.index()] = Some(coordinates.len());
-                if on.negative {
-                    sign[on.axis.index()] = -1.0;
-                }
+                coordinate[axis.index()] = Some(coordinates.len());
                 columns.push(BASE_COLUMNS + coordinates.len());
                 coordinates.push(Coordinate {
                     joint: j.name.clone(),
@@ -135,8 +136,11 @@ impl Skeleton {
                 imu: j.distal.clone(),
                 parent: Some(parent),
                 coordinate,
-                sign,
-                fixed: j.segment_angles(j.default_pose_deg).map(f64::to_radians),
+                frame: j
+                    .table_axes()
+                    .map_or_else(crate::rotation::Quat::identity, |a| a.q),
+                det: j.table_axes().map_or(1.0, |a| a.det),
+                fixed: j.default_pose_deg.map(f64::to_radians),
                 weight: model.weight(&j.distal),
                 columns,
             });
@@ -153,14 +157,14 @@ impl Skeleton {
         BASE_COLUMNS + self.coordinates.len()
     }
 
-    /// The segment frames' Z-Y-X angles `[x, y, z]` of a segment's joint
-    /// (radians) for coordinates `q`.
+    /// The table-convention angles `[x, y, z]` of a segment's joint (radians)
+    /// for coordinates `q`.
     pub fn joint_angles(&self, segment: usize, q: &[f64]) -> [f64; 3] {
         let s = &self.segments[segment];
         let mut a = s.fixed;
         for (k, c) in s.coordinate.iter().enumerate() {
             if let Some(c) = c {
-                a[k] = s.sign[k] * q[*c];
+                a[k] = q[*c];
             }
         }
         a

@@ -148,14 +148,16 @@ impl<'a> Solver<'a> {
         for (k, s) in sk.segments.iter().enumerate().skip(1) {
             let p = s.parent.expect("only the base has no parent");
             let rel = self.orient[p].inverse() * measured[k];
-            let e = euler_zyx_deg(&rel).map(f64::to_radians);
+            let in_table = s.frame.inverse() * rel * s.frame;
+            let e = euler_zyx_deg(&in_table).map(|a| (s.det * a).to_radians());
             for (axis, c) in s.coordinate.iter().enumerate() {
                 if let Some(c) = *c {
                     let co = &sk.coordinates[c];
-                    pose.q[c] = (s.sign[axis] * e[axis]).clamp(co.lower, co.upper);
+                    pose.q[c] = e[axis].clamp(co.lower, co.upper);
                 }
             }
-            self.orient[k] = self.orient[p] * joint_rotation(sk.joint_angles(k, &pose.q));
+            let table = sk.joint_angles(k, &pose.q).map(|a| s.det * a);
+            self.orient[k] = self.orient[p] * s.frame * joint_rotation(table) * s.frame.inverse();
         }
         pose
     }
@@ -351,20 +353,22 @@ pub fn joint_rotation(a: [f64; 3]) -> Quat {
 pub fn forward(sk: &Skeleton, pose: &Pose, orient: &mut [Quat], axes: &mut [Vector3<f64>]) {
     orient[0] = pose.base;
     for (k, s) in sk.segments.iter().enumerate().skip(1) {
-        let p = orient[s.parent.expect("only the base has no parent")];
-        let [x, y, z] = sk.joint_angles(k, &pose.q);
+        // S_d = S_p Q Rz(d z) Ry(d y) Rx(d x) Q^T (module docs).
+        let p = orient[s.parent.expect("only the base has no parent")] * s.frame;
+        let [x, y, z] = sk.joint_angles(k, &pose.q).map(|a| s.det * a);
         let pz = p * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), z);
         let pzy = pz * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), y);
         if let Some(c) = s.coordinate[2] {
-            axes[c] = (p * Vector3::z()) * s.sign[2];
+            axes[c] = (p * Vector3::z()) * s.det;
         }
         if let Some(c) = s.coordinate[1] {
-            axes[c] = (pz * Vector3::y()) * s.sign[1];
+            axes[c] = (pz * Vector3::y()) * s.det;
         }
         if let Some(c) = s.coordinate[0] {
-            axes[c] = (pzy * Vector3::x()) * s.sign[0];
+            axes[c] = (pzy * Vector3::x()) * s.det;
         }
-        orient[k] = pzy * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), x);
+        orient[k] =
+            pzy * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), x) * s.frame.inverse();
     }
 }
 

@@ -52,19 +52,23 @@ pub fn pronation_rate_deg_s(t_s: f64) -> f64 {
 }
 
 /// Angular rate of the forearm segment of `elbow` at `t_s` in its own frame,
-/// rad/s, in closed form: with `G_R_forearm = Rz(z) Ry(y) Rx(x)` (the segment
-/// angles of `[flex, 0, pro]`) and a static upper arm,
-/// `w = Rx^T (Ry^T (z' Z) + y' Y) + x' X` (`Rx(flex)^T (pro' Z) + flex' X` in
-/// `infant13`'s frames). A forearm IMU misaligned by `M` reads `M^-1 w` (the
-/// upper arm's reads zero).
+/// rad/s, in closed form. The joint rotation of `[flex, 0, pro]` is
+/// `Q T Q^T` with `T = Rz(d pro) Rx(d flex)` (`Q`, `d`: the joint's table
+/// axes, docs/method.md section 2.5; `Q = I`, `d = 1` in `infant13`), so with a
+/// static upper arm `w = Q (Rx(d flex)^T (d pro' Z) + d flex' X)`. A forearm
+/// IMU misaligned by `M` reads `M^-1 w` (the upper arm's reads zero).
 pub fn forearm_rate(elbow: &Joint, t_s: f64) -> Vector3<f64> {
-    let [x, y, _] = elbow.segment_angles([flexion_deg(t_s), 0.0, pronation_deg(t_s)]);
-    let [dx, dy, dz] = elbow
-        .segment_angles([flexion_rate_deg_s(t_s), 0.0, pronation_rate_deg_s(t_s)])
-        .map(f64::to_radians);
+    let axes = elbow.table_axes();
+    let d = axes.map_or(1.0, |a| a.det);
+    let x = d * flexion_deg(t_s);
+    let [dx, dz] =
+        [flexion_rate_deg_s(t_s), pronation_rate_deg_s(t_s)].map(|r| (d * r).to_radians());
     let rx = rotation::quat_axis_angle_deg([1.0, 0.0, 0.0], x);
-    let ry = rotation::quat_axis_angle_deg([0.0, 1.0, 0.0], y);
-    rx.inverse() * (ry.inverse() * (Vector3::z() * dz) + Vector3::y() * dy) + Vector3::x() * dx
+    let w = rx.inverse() * (Vector3::z() * dz) + Vector3::x() * dx;
+    match axes {
+        Some(a) => a.q * w,
+        None => w,
+    }
 }
 
 /// Upper arm static at identity, forearm = upper arm * the elbow's rotation
@@ -150,15 +154,11 @@ mod tests {
                 let want = elbow.rotation([flexion_deg(t), 0.0, pronation_deg(t)]);
                 let got = upper[k].inverse() * fore[k];
                 assert!(rotation::angle_between_deg(&got, &want) < 1e-9);
-                // Standing frames make flexion the middle Z-Y-X angle, which
-                // reads at most 90 deg (beyond, the same rotation reads as
-                // 180 - flexion with the other two angles turned half a turn)
-                // and leaves the other two ill-conditioned near 90.
-                let singular = elbow.segment_axis(Axis::X).axis == Axis::Y && flexion_deg(t) > 80.0;
-                if !singular {
-                    assert!((a[0] - flexion_deg(t)).abs() < 1e-7 && a[1].abs() < 1e-7);
-                    assert!((a[2] - pronation_deg(t)).abs() < 1e-7);
-                }
+                // Every model reads flexion (X) and pronation (Z) as they
+                // were made, beyond 90 deg of flexion too (the Z-Y-X angles
+                // are taken in the table's axes, docs/method.md section 2.5).
+                assert!((a[0] - flexion_deg(t)).abs() < 1e-7 && a[1].abs() < 1e-7);
+                assert!((a[2] - pronation_deg(t)).abs() < 1e-7);
                 lo = lo.min(flexion_deg(t));
                 hi = hi.max(flexion_deg(t));
             }

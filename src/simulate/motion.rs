@@ -109,8 +109,9 @@ pub(super) fn joint_motion(rng: &mut ChaCha8Rng, table: &LimitTable, joint: &Joi
         let (mut lo, mut hi) = limits.map_or((-10.0, 10.0), |l| {
             (l.range_deg[axis][0], l.range_deg[axis][1])
         });
-        // The segment frames' middle (Y) angle stays clear of its singularity.
-        if joint.angle_axes[axis].axis == crate::model::Axis::Y {
+        // The middle (Y) angle of Z-Y-X in the table's axes stays clear of
+        // its singularity (docs/method.md section 2.5).
+        if axis == crate::model::Axis::Y.index() {
             lo = lo.max(-MAX_ABS_Y_DEG);
             hi = hi.min(MAX_ABS_Y_DEG);
         }

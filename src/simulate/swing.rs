@@ -35,8 +35,9 @@ pub fn range_deg(table: &LimitTable, joint: &Joint, axis: usize) -> [f64; 2] {
         .map_or([-10.0, 10.0], |l| l.range_deg[axis]);
     let cut = SHRINK_FRACTION * (hi - lo);
     let (mut lo, mut hi) = (lo + cut, hi - cut);
-    // The segment frames' middle (Y) angle stays clear of its singularity.
-    if joint.angle_axes[axis].axis == crate::model::Axis::Y {
+    // The middle (Y) angle of Z-Y-X in the table's axes stays clear of
+    // its singularity (docs/method.md section 2.5).
+    if axis == crate::model::Axis::Y.index() {
         lo = lo.max(-MAX_ABS_Y_DEG);
         hi = hi.min(MAX_ABS_Y_DEG);
     }
