@@ -325,20 +325,6 @@ impl LimitTerms {
     pub(super) fn centroid_term(&self, d: f64) -> f64 {
         self.lambda2 * rmsq_of_dot(d)
     }
-
-    /// The centroid terms summed over quaternions `qs` (`[w, x, y, z]`) dotted
-    /// with `p` (0 without the term).
-    pub(super) fn centroid_sum<'a>(&self, qs: impl Iterator<Item = &'a [f64; 4]>, p: &Quat) -> f64 {
-        if self.centroid.is_none() {
-            return 0.0;
-        }
-        let p = [p.w, p.i, p.j, p.k];
-        let mut sum = 0.0;
-        for q in qs {
-            sum += rmsq_of_dot(q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] * p[3]);
-        }
-        self.lambda2 * sum
-    }
 }
 
 /// [`rmsq`] of two unit quaternions from their dot product `d`: `sqrt(2 - 2|d|)`.
@@ -359,12 +345,6 @@ pub(super) fn matrix_vectors(q: &Quat, rows: bool) -> [[f64; 3]; 3] {
         }
     };
     [v(0), v(1), v(2)]
-}
-
-/// `a . b` of 3-vectors.
-#[inline(always)]
-pub(super) fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// The samples of a window laid out for the evaluation loop (structure of
@@ -397,7 +377,7 @@ impl Samples {
 
 /// Samples evaluated together: the matrix products of a block are formed in
 /// one loop the compiler can vectorise, then the range tests run over them.
-const BLOCK: usize = 64;
+pub(super) const BLOCK: usize = 64;
 
 /// The cost of one joint over one window, prepared for many evaluations.
 #[derive(Debug, Clone)]
