@@ -276,6 +276,38 @@ impl LimitTerms {
         ex + ey + ez
     }
 
+    /// As [`LimitTerms::excursion`], with the excursion's derivative
+    /// (degrees per radian) along a path on which the entries move at rates
+    /// `d` (per radian): `d phi = (r22 d21 - r21 d22) / rho`,
+    /// `d theta = -d20 / sqrt(rho)`, `d psi = (r00 d10 - r10 d00) / sigma`,
+    /// `rho = r21^2 + r22^2`, `sigma = r00^2 + r10^2`. At a kink it is the
+    /// derivative of one side.
+    #[inline(always)]
+    pub(super) fn excursion_along(
+        &self,
+        [r00, r10, r20, r21, r22]: [f64; 5],
+        [d00, d10, d20, d21, d22]: [f64; 5],
+    ) -> (f64, f64) {
+        let (ex, sx) = self.x.excursion_slope(r21, r22);
+        let (ey, sy) = self.y.excursion_slope(r20);
+        let (ez, sz) = self.z.excursion_slope(r10, r00);
+        let mut slope = 0.0;
+        let rho = r21 * r21 + r22 * r22;
+        if sx != 0.0 && rho > 0.0 {
+            slope += sx * (r22 * d21 - r21 * d22) / rho;
+        }
+        if sy != 0.0 && rho > 0.0 {
+            slope -= sy * d20 / rho.sqrt();
+        }
+        if sz != 0.0 {
+            let sigma = r00 * r00 + r10 * r10;
+            if sigma > 0.0 {
+                slope += sz * (r00 * d10 - r10 * d00) / sigma;
+            }
+        }
+        (ex + ey + ez, slope * DEG)
+    }
+
     /// `lambda2 * sum RMSq` over quaternions held as component arrays `q`
     /// (`[w, x, y, z]`) dotted with `p`. With `weighted`, adds to it the sum
     /// of `d(lambda2 RMSq_i)/d(d_i) * q_i` (`d_i = q_i . p`), from which the
@@ -324,6 +356,15 @@ impl LimitTerms {
     #[inline(always)]
     pub(super) fn centroid_term(&self, d: f64) -> f64 {
         self.lambda2 * rmsq_of_dot(d)
+    }
+
+    /// [`LimitTerms::centroid_term`] and its derivative along a path on which
+    /// `d` moves at rate `dd`; 0 at the centroid itself (the cone's tip).
+    #[inline(always)]
+    pub(super) fn centroid_term_along(&self, d: f64, dd: f64) -> (f64, f64) {
+        let r = rmsq_of_dot(d);
+        let slope = if r > 1e-12 { -d.signum() * dd / r } else { 0.0 };
+        (self.lambda2 * r, self.lambda2 * slope)
     }
 }
 

@@ -134,6 +134,45 @@ impl HeadingCost {
         }
         sum / self.samples.len() as f64 + penalty
     }
+
+    /// [`HeadingCost::eval`] and its derivative in `h` (degrees per degree),
+    /// from `dRt/dh = cos(h) M1 + sin(h) M2` (per radian) and
+    /// `dq/dh = (-sin(h/2) a + cos(h/2) b) / 2`. At a kink (a sample on a
+    /// limit, `h = 0`) it is the derivative of one side (`+lambda1` at `h = 0`).
+    pub fn eval_slope(&self, h_deg: f64) -> (f64, f64) {
+        let penalty = self.c_penalty + self.lambda1 * h_deg.abs();
+        let penalty_slope = self.lambda1 * h_deg.signum();
+        if self.samples.is_empty() {
+            return (penalty, penalty_slope);
+        }
+        let (s, c) = h_deg.to_radians().sin_cos();
+        let v = 1.0 - c;
+        let (sh, ch) = (0.5 * h_deg.to_radians()).sin_cos();
+        let centroid = self.terms.centroid.is_some();
+        let (mut sum, mut slope) = (0.0, 0.0);
+        for p in &self.samples {
+            let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
+            let d = |j: usize| c * p.m1[j] + s * p.m2[j];
+            let (e, de) = self
+                .terms
+                .excursion_along([r(0), r(1), r(2), r(3), r(4)], [d(0), d(1), d(2), d(3), d(4)]);
+            sum += e;
+            slope += de;
+            if centroid {
+                let [a, b] = p.centroid_dots;
+                let (e, de) = self
+                    .terms
+                    .centroid_term_along(ch * a + sh * b, 0.5 * (ch * b - sh * a));
+                sum += e;
+                slope += de;
+            }
+        }
+        let n = self.samples.len() as f64;
+        (
+            sum / n + penalty,
+            (slope / n).to_radians() + penalty_slope,
+        )
+    }
 }
 
 #[cfg(test)]
@@ -163,6 +202,44 @@ mod tests {
                 assert!((fast - direct).abs() < 1e-9, "h {h}: {fast} vs {direct}");
             }
         }
+    }
+
+    #[test]
+    fn heading_slope_matches_finite_differences() {
+        let shoulder = JointLimits {
+            range_deg: [[-10.0, 100.0], [-40.0, 60.0], [-70.0, 70.0]],
+            centroid_deg: Some([47.0, -1.0, -31.0]),
+            lambda2: 30.0,
+        };
+        let knee = JointLimits {
+            range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
+            centroid_deg: None,
+            lambda2: 0.0,
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let parent: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
+        let child: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
+        let mut near_kink = 0;
+        for limits in [shoulder, knee] {
+            let c = random_quat(&mut rng, 40.0);
+            let cost = HeadingCost::new(&parent, &child, &c, [0.0, 0.0, 1.0], &limits, 0.05, 1);
+            for h in [-170.0, -33.3, 4.5, 17.0, 90.2] {
+                let (f, slope) = cost.eval_slope(h);
+                assert_eq!(f, cost.eval(h));
+                // One-sided differences over 1e-6 deg; a kink within the step
+                // makes them disagree, and the point is skipped.
+                let step = 1e-6;
+                let up = (cost.eval(h + step) - f) / step;
+                let down = (f - cost.eval(h - step)) / step;
+                let tol = 1e-4 * (1.0 + slope.abs());
+                if (up - down).abs() > tol {
+                    near_kink += 1;
+                    continue;
+                }
+                assert!((0.5 * (up + down) - slope).abs() < tol, "h {h}: {up} vs {slope}");
+            }
+        }
+        assert!(near_kink < 3, "{near_kink} of 10 near a kink");
     }
 
     #[test]
