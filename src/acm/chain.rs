@@ -543,10 +543,7 @@ impl Pass<'_> {
             own: problem,
             children: &children,
         };
-        let opts = HeadingOptions {
-            solver: self.settings.solver,
-            ..HeadingOptions::default()
-        };
+        let opts = HeadingOptions::for_solver(self.settings.solver);
         let (sol, heading, orientation) =
             solve_heading(&trial.time_s, &lookahead, &opts, (&joint.name, &joint.distal));
         self.windows

@@ -94,23 +94,34 @@ impl HeadingOptions {
     /// scan)` does one round on every `stride`-th sample (`scan`: scan the
     /// whole circle for each heading; the very first round only, when
     /// `global_scan`) and returns the objective; a phase ends when a round
-    /// gains less than its tolerance or its rounds run out.
-    pub(super) fn run_phases(&self, mut round: impl FnMut(usize, bool) -> f64) {
+    /// gains less than its tolerance or its rounds run out. Returns the last
+    /// round's objective.
+    pub(super) fn run_phases(&self, mut round: impl FnMut(usize, bool) -> f64) -> f64 {
         let phases = [
             (self.coarse_stride, self.coarse_rounds, self.coarse_tol),
             (self.fine_stride, self.fine_rounds, self.tol),
         ];
         let mut first = true;
+        let mut j = f64::INFINITY;
         for (stride, max_rounds, tol) in phases {
             let mut last = f64::INFINITY;
             for _ in 0..max_rounds {
-                let j = round(stride, self.global_scan && first);
+                j = round(stride, self.global_scan && first);
                 first = false;
                 if last - j < tol {
                     break;
                 }
                 last = j;
             }
+        }
+        j
+    }
+
+    /// The default options with `solver`.
+    pub fn for_solver(solver: Solver) -> Self {
+        HeadingOptions {
+            solver,
+            ..HeadingOptions::default()
         }
     }
 
@@ -151,9 +162,10 @@ pub struct HeadingFit {
     pub rounds: usize,
     /// Samples evaluated in all, over every step (the solver's work).
     pub sample_evaluations: usize,
-    /// The objective at the solution on every sample: `J(C, h)` plus, with
-    /// the lookahead, the child joints' weighted terms at their auxiliary
-    /// fit (degrees; what the solvers are compared on).
+    /// The objective at the solution as the last round measured it (on every
+    /// `fine_stride`-th sample): `J(C, h)` plus, with the lookahead, the child
+    /// joints' weighted terms at their auxiliary fit (degrees; what the
+    /// solvers are compared on).
     pub objective: f64,
 }
 
@@ -208,17 +220,6 @@ impl HeadingProblem<'_> {
         )
     }
 
-    /// `J(C, h)` on every `stride`-th sample.
-    pub(super) fn total_at(&self, c: &Quat, headings: &[f64], stride: usize) -> f64 {
-        let costs: Vec<f64> = self
-            .windows
-            .par_iter()
-            .zip(headings)
-            .map(|(w, &h)| self.heading_cost(w, c, stride).eval(h))
-            .collect();
-        costs.iter().sum()
-    }
-
     /// `e_k(C, h_k)` per window at full resolution.
     pub fn window_costs(&self, c: &Quat, headings: &[f64]) -> Vec<f64> {
         self.windows
@@ -240,7 +241,7 @@ impl HeadingProblem<'_> {
             sample_evaluations: 0,
             first_window_start: opts.first_window_start,
         };
-        opts.run_phases(|stride, scan| state.round(self, stride, scan, opts));
+        let objective = opts.run_phases(|stride, scan| state.round(self, stride, scan, opts));
         let Alternation {
             c,
             h,
@@ -255,7 +256,7 @@ impl HeadingProblem<'_> {
         HeadingFit {
             c,
             headings_deg: h,
-            objective: window_costs.iter().sum(),
+            objective,
             window_costs,
             window_costs_uncorrected,
             window_evaluations,
@@ -415,7 +416,7 @@ impl Alternation {
         self.sample_evaluations += s.evaluations * step.samples();
         self.c = s.c;
         let (c, h) = (&self.c, &self.h);
-        let steps: Vec<(f64, usize, usize)> = (0..h.len())
+        let steps: Vec<(f64, usize, usize, f64)> = (0..h.len())
             .into_par_iter()
             .map(|k| {
                 let cost = p.heading_cost(&p.windows[k], c, stride);
@@ -425,15 +426,18 @@ impl Alternation {
                 let slope = |x: f64| cost.eval_slope(x);
                 let scan = (scan, opts.scan_step_deg);
                 let (hk, e) = heading_search(&value, &slope, &starts, scan, opts.solver);
-                (hk, e, e * cost.len())
+                (hk, e, e * cost.len(), cost.eval(hk))
             })
             .collect();
-        for (k, (hk, e, work)) in steps.into_iter().enumerate() {
+        let mut costs = Vec::with_capacity(steps.len());
+        for (k, (hk, e, work, cost)) in steps.into_iter().enumerate() {
             self.h[k] = hk;
             self.window_evaluations[k] += e;
             self.sample_evaluations += work;
+            costs.push(cost);
         }
-        p.total_at(&self.c, &self.h, stride)
+        // J, from the window costs the heading step built.
+        costs.iter().sum()
     }
 }
 
@@ -739,6 +743,33 @@ mod tests {
         let (local, _) = line_search(&f, &[0.0], false, 4.0);
         assert!(f(x) <= f(local), "{x} vs {local}");
         assert!(f(x) < f(0.0));
+    }
+
+    #[test]
+    fn slope_search_finds_smooth_kinked_and_far_minima() {
+        // A smooth bowl, from 0 without the scan.
+        let bowl = |x: f64| ((x - 12.3).powi(2), 2.0 * (x - 12.3));
+        let (x, _) = slope_search(&|x| bowl(x).0, &bowl, &[0.0], false, 4.0);
+        assert!((x - 12.3).abs() < 1e-6, "{x}");
+        // A minimum on the kink of lambda1 |h| at 0 (the common case of no
+        // drift): found exactly, as the point evaluated there.
+        let cone = |x: f64| (0.05 * x.abs() + 0.01 * x * x, 0.05 * x.signum() + 0.02 * x);
+        let (x, _) = slope_search(&|x| cone(x).0, &cone, &[3.0], false, 4.0);
+        assert!(x.abs() < 1e-6, "{x}");
+        let (x, _) = slope_search(&|x| cone(x).0, &cone, &[0.0], false, 4.0);
+        assert_eq!(x, 0.0);
+        // A far kinked minimum behind a ripple: with the scan, as good as the
+        // pattern search.
+        let far = |x: f64| {
+            let f = (x - 100.0).abs() + 0.05 * x.abs() + 10.0 * ((x / 7.0).sin() + 1.0);
+            let d = (x - 100.0).signum() + 0.05 * x.signum() + 10.0 / 7.0 * (x / 7.0).cos();
+            (f, d)
+        };
+        let value = |x: f64| far(x).0;
+        let (x, evals) = slope_search(&value, &far, &[0.0], true, 4.0);
+        let (y, pattern_evals) = line_search(&value, &[0.0], true, 4.0);
+        assert!(value(x) <= value(y) + 1e-9, "{x} {y}");
+        assert!(evals < pattern_evals, "{evals} vs {pattern_evals}");
     }
 
     #[test]

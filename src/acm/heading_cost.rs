@@ -17,14 +17,10 @@
 use super::cost::LimitTerms;
 use crate::limits::JointLimits;
 use crate::rotation::{angle_deg, Quat};
-use nalgebra::{Matrix3, Quaternion};
+use nalgebra::{Quaternion, Vector3};
 
 /// The entries `r00, r10, r20, r21, r22` of a rotation matrix.
 type Entries = [f64; 5];
-
-fn entries(m: &Matrix3<f64>) -> Entries {
-    [m[(0, 0)], m[(1, 0)], m[(2, 0)], m[(2, 1)], m[(2, 2)]]
-}
 
 /// One sample prepared for evaluation at any heading.
 #[derive(Debug, Clone, Copy)]
@@ -34,6 +30,46 @@ struct Sample {
     m2: Entries,
     /// `a . qc` and `b . qc` (0 without centroid term).
     centroid_dots: [f64; 2],
+}
+
+impl Sample {
+    /// The sample of parent orientation `p` and right factor `b = G_R_dist C`:
+    /// the entries of `P^T X` for `X = B, -K B, K^2 B`, formed from the rows of
+    /// `P^T` (the columns of `P`) and the columns of `B` turned by `up x`
+    /// (`K v = up x v`), and the centroid's two dot products.
+    fn new(p: &Quat, b: &Quat, up: &Vector3<f64>, centroid: Option<&Quat>) -> Self {
+        let pm = p.to_rotation_matrix().into_inner();
+        let bm = b.to_rotation_matrix().into_inner();
+        let rows = [pm.column(0), pm.column(1), pm.column(2)];
+        let cols: [Vector3<f64>; 3] = std::array::from_fn(|j| bm.column(j).into_owned());
+        let kb = cols.map(|v| up.cross(&v));
+        let k2b = kb.map(|v| up.cross(&v));
+        let entries = |x: &[Vector3<f64>; 3], sign: f64| -> Entries {
+            [
+                sign * rows[0].dot(&x[0]),
+                sign * rows[1].dot(&x[0]),
+                sign * rows[2].dot(&x[0]),
+                sign * rows[2].dot(&x[1]),
+                sign * rows[2].dot(&x[2]),
+            ]
+        };
+        let centroid_dots = match centroid {
+            Some(qc) => {
+                let pt = p.inverse().into_inner();
+                let minus_up = Quaternion::new(0.0, -up[0], -up[1], -up[2]);
+                let qa = pt * b.into_inner();
+                let qb = pt * minus_up * b.into_inner();
+                [qa.coords.dot(&qc.coords), qb.coords.dot(&qc.coords)]
+            }
+            None => [0.0, 0.0],
+        };
+        Sample {
+            m0: entries(&cols, 1.0),
+            m1: entries(&kb, -1.0),
+            m2: entries(&k2b, 1.0),
+            centroid_dots,
+        }
+    }
 }
 
 /// The cost of one joint over one window as a function of the heading correction.
@@ -60,39 +96,14 @@ impl HeadingCost {
         lambda1: f64,
         stride: usize,
     ) -> Self {
-        let k = Matrix3::new(
-            0.0, -up[2], up[1], //
-            up[2], 0.0, -up[0], //
-            -up[1], up[0], 0.0,
-        );
-        let k2 = k * k;
+        let up = Vector3::new(up[0], up[1], up[2]);
         let terms = LimitTerms::new(limits);
         let centroid = terms.centroid;
-        let minus_up = Quaternion::new(0.0, -up[0], -up[1], -up[2]);
         let samples = parent
             .iter()
             .zip(child)
             .step_by(stride.max(1))
-            .map(|(p, d)| {
-                let b = d * c;
-                let pt = p.inverse();
-                let pm = pt.to_rotation_matrix().into_inner();
-                let bm = b.to_rotation_matrix().into_inner();
-                let centroid_dots = match centroid {
-                    Some(qc) => {
-                        let qa = pt.into_inner() * b.into_inner();
-                        let qb = pt.into_inner() * minus_up * b.into_inner();
-                        [qa.coords.dot(&qc.coords), qb.coords.dot(&qc.coords)]
-                    }
-                    None => [0.0, 0.0],
-                };
-                Sample {
-                    m0: entries(&(pm * bm)),
-                    m1: entries(&(-(pm * k * bm))),
-                    m2: entries(&(pm * k2 * bm)),
-                    centroid_dots,
-                }
-            })
+            .map(|(p, d)| Sample::new(p, &(d * c), &up, centroid.as_ref()))
             .collect();
         HeadingCost {
             samples,

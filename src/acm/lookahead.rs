@@ -112,11 +112,9 @@ impl Lookahead<'_> {
             rounds: 0,
             sample_evaluations: 0,
         };
-        opts.run_phases(|stride, scan| self.round(&mut s, stride, scan, opts));
+        let objective = opts.run_phases(|stride, scan| self.round(&mut s, stride, scan, opts));
         let window_costs = self.own.window_costs(&s.c, &s.h);
         let window_costs_uncorrected = self.own.window_costs(&Quat::identity(), &vec![0.0; n]);
-        let objective =
-            window_costs.iter().sum::<f64>() + CHILD_WEIGHT * self.children_total(&s, 1);
         HeadingFit {
             c: s.c,
             headings_deg: s.h,
@@ -136,13 +134,16 @@ impl Lookahead<'_> {
         s.rounds += 1;
         let first = s.rounds == 1;
         self.c_step(s, stride, first && opts.first_window_start, opts);
-        self.heading_step(s, stride, scan, opts);
+        let own = self.heading_step(s, stride, scan, opts);
+        let mut children = Vec::with_capacity(self.children.len() * s.h.len());
         for j in 0..self.children.len() {
             let fixed = self.fixed_parent(&s.c);
             self.child_c_step(s, j, &fixed, stride, opts);
-            self.child_heading_step(s, j, &fixed, (stride, scan), opts);
+            children.extend(self.child_heading_step(s, j, &fixed, (stride, scan), opts));
         }
-        self.total_at(s, stride)
+        // J from the window costs the steps built: the IMU's own terms do not
+        // change after its heading step, nor child j's after its own.
+        own.iter().sum::<f64>() + CHILD_WEIGHT * children.iter().sum::<f64>()
     }
 
     /// `X_i C`: the IMU corrected but for its heading, per sample.
@@ -220,11 +221,18 @@ impl Lookahead<'_> {
     }
 
     /// The heading step: each `h_k` on the IMU's own window cost plus the
-    /// children's heading penalties (their relative headings held).
-    fn heading_step(&self, s: &mut State, stride: usize, scan: bool, opts: &HeadingOptions) {
+    /// children's heading penalties (their relative headings held). Returns
+    /// the own window costs `e_k(C, h_k)` at the new headings.
+    fn heading_step(
+        &self,
+        s: &mut State,
+        stride: usize,
+        scan: bool,
+        opts: &HeadingOptions,
+    ) -> Vec<f64> {
         let (c, h) = (&s.c, &s.h);
         let state: &State = s;
-        let steps: Vec<(f64, usize, usize)> = (0..h.len())
+        let steps: Vec<(f64, usize, usize, f64)> = (0..h.len())
             .into_par_iter()
             .map(|k| {
                 let cost = self.own.heading_cost(&self.own.windows[k], c, stride);
@@ -237,14 +245,17 @@ impl Lookahead<'_> {
                 let scan = (scan, opts.scan_step_deg);
                 let starts = neighbour_starts(h, k);
                 let (hk, e) = heading_search(&value, &slope, &starts, scan, opts.solver);
-                (hk, e, e * cost.len())
+                (hk, e, e * cost.len(), cost.eval(hk))
             })
             .collect();
-        for (k, (hk, e, work)) in steps.into_iter().enumerate() {
+        let mut own = Vec::with_capacity(steps.len());
+        for (k, (hk, e, work, cost)) in steps.into_iter().enumerate() {
             s.h[k] = hk;
             s.window_evaluations[k] += e;
             s.sample_evaluations += work;
+            own.push(cost);
         }
+        own
     }
 
     /// Child j's constant correction on all windows: `Rm_i = (X_i C)^T R_up(-r_jk) Y_i`.
@@ -284,7 +295,9 @@ impl Lookahead<'_> {
         s.children[j].c = m.c;
     }
 
-    /// Child j's heading relative to the IMU's, per window.
+    /// Child j's heading relative to the IMU's, per window. Returns its
+    /// terms of J per window at the new headings (its window cost plus
+    /// `lambda1 |h_k + r_jk|`).
     fn child_heading_step(
         &self,
         s: &mut State,
@@ -292,10 +305,10 @@ impl Lookahead<'_> {
         fixed: &[Quat],
         (stride, scan): (usize, bool),
         opts: &HeadingOptions,
-    ) {
+    ) -> Vec<f64> {
         let st = &s.children[j];
         let h = &s.h;
-        let steps: Vec<(f64, usize, usize)> = (0..h.len())
+        let steps: Vec<(f64, usize, usize, f64)> = (0..h.len())
             .into_par_iter()
             .map(|k| {
                 let cost = self.child_cost(j, st, fixed, k, stride);
@@ -308,14 +321,17 @@ impl Lookahead<'_> {
                 let scan = (scan, opts.scan_step_deg);
                 let starts = neighbour_starts(&st.r, k);
                 let (rk, e) = heading_search(&value, &slope, &starts, scan, opts.solver);
-                (rk, e, e * cost.len())
+                (rk, e, e * cost.len(), value(rk))
             })
             .collect();
-        for (k, (rk, e, work)) in steps.into_iter().enumerate() {
+        let mut terms = Vec::with_capacity(steps.len());
+        for (k, (rk, e, work, term)) in steps.into_iter().enumerate() {
             s.children[j].r[k] = rk;
             s.sample_evaluations += work;
             s.window_evaluations[k] += e;
+            terms.push(term);
         }
+        terms
     }
 
     /// Child joint j's window k as a function of its relative heading, with the
@@ -343,27 +359,6 @@ impl Lookahead<'_> {
             cost,
             c_penalty: self.own.lambda1 * angle_deg(&st.c),
         }
-    }
-
-    /// J on every `stride`-th sample.
-    fn total_at(&self, s: &State, stride: usize) -> f64 {
-        self.own.total_at(&s.c, &s.h, stride) + CHILD_WEIGHT * self.children_total(s, stride)
-    }
-
-    /// The child joints' terms of J (unweighted) on every `stride`-th sample.
-    fn children_total(&self, s: &State, stride: usize) -> f64 {
-        let fixed = self.fixed_parent(&s.c);
-        let children: Vec<f64> = (0..self.children.len())
-            .flat_map(|j| (0..s.h.len()).map(move |k| (j, k)))
-            .collect::<Vec<_>>()
-            .par_iter()
-            .map(|&(j, k)| {
-                let st = &s.children[j];
-                self.child_cost(j, st, &fixed, k, stride).eval(st.r[k])
-                    + self.own.lambda1 * (s.h[k] + st.r[k]).abs()
-            })
-            .collect();
-        children.iter().sum::<f64>()
     }
 }
 
