@@ -179,4 +179,3 @@ fn heading_fit_with_the_gradient_solver_is_never_worse_than_nelder_mead() {
         tally.joints, tally.lower, tally.worst_rel, tally.c_evals[0], tally.c_evals[1], tally.sums[0], tally.sums[1]
     );
 }
-

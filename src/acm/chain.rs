@@ -544,8 +544,12 @@ impl Pass<'_> {
             children: &children,
         };
         let opts = HeadingOptions::for_solver(self.settings.solver);
-        let (sol, heading, orientation) =
-            solve_heading(&trial.time_s, &lookahead, &opts, (&joint.name, &joint.distal));
+        let (sol, heading, orientation) = solve_heading(
+            &trial.time_s,
+            &lookahead,
+            &opts,
+            (&joint.name, &joint.distal),
+        );
         self.windows
             .iter()
             .for_each(|_| self.progress.window_done());

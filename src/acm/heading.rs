@@ -347,7 +347,13 @@ impl CStep<'_> {
 
     /// Minimises the objective from `start` with `solver`, tuned for round
     /// `round` (from 1) on every `stride`-th sample.
-    pub(super) fn solve(&self, start: &Quat, round: usize, stride: usize, solver: Solver) -> Solution {
+    pub(super) fn solve(
+        &self,
+        start: &Quat,
+        round: usize,
+        stride: usize,
+        solver: Solver,
+    ) -> Solution {
         match solver {
             Solver::NelderMead => minimise(
                 &|q| self.value(q),
@@ -398,7 +404,13 @@ struct Alternation {
 impl Alternation {
     /// One C step then one heading step on every `stride`-th sample; returns J
     /// there. Neither step raises J.
-    fn round(&mut self, p: &HeadingProblem, stride: usize, scan: bool, opts: &HeadingOptions) -> f64 {
+    fn round(
+        &mut self,
+        p: &HeadingProblem,
+        stride: usize,
+        scan: bool,
+        opts: &HeadingOptions,
+    ) -> f64 {
         self.rounds += 1;
         let mut costs = p.c_costs(&self.h, stride);
         if self.rounds == 1 && self.first_window_start {
@@ -580,10 +592,18 @@ fn descend_on_slope(f: &dyn Fn(f64) -> (f64, f64), x0: f64, step: f64) -> (f64, 
         if fx < best.1 {
             best = (x, fx);
         }
-        Probe { x, f: fx, s: dx * dir }
+        Probe {
+            x,
+            f: fx,
+            s: dx * dir,
+        }
     };
     // `lo`: the downhill end (slope along `dir` below zero); `hi`: beyond the minimum.
-    let mut lo = Probe { x: x0, f: f0, s: d0 * dir };
+    let mut lo = Probe {
+        x: x0,
+        f: f0,
+        s: d0 * dir,
+    };
     let mut t = step;
     let mut hi = loop {
         let p = probe(lo.x + dir * t, &mut evals);

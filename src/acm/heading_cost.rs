@@ -164,9 +164,10 @@ impl HeadingCost {
         for p in &self.samples {
             let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
             let d = |j: usize| c * p.m1[j] + s * p.m2[j];
-            let (e, de) = self
-                .terms
-                .excursion_along([r(0), r(1), r(2), r(3), r(4)], [d(0), d(1), d(2), d(3), d(4)]);
+            let (e, de) = self.terms.excursion_along(
+                [r(0), r(1), r(2), r(3), r(4)],
+                [d(0), d(1), d(2), d(3), d(4)],
+            );
             sum += e;
             slope += de;
             if centroid {
@@ -179,10 +180,7 @@ impl HeadingCost {
             }
         }
         let n = self.samples.len() as f64;
-        (
-            sum / n + penalty,
-            (slope / n).to_radians() + penalty_slope,
-        )
+        (sum / n + penalty, (slope / n).to_radians() + penalty_slope)
     }
 }
 
@@ -247,7 +245,10 @@ mod tests {
                     near_kink += 1;
                     continue;
                 }
-                assert!((0.5 * (up + down) - slope).abs() < tol, "h {h}: {up} vs {slope}");
+                assert!(
+                    (0.5 * (up + down) - slope).abs() < tol,
+                    "h {h}: {up} vs {slope}"
+                );
             }
         }
         assert!(near_kink < 3, "{near_kink} of 10 near a kink");

@@ -316,7 +316,10 @@ impl Lookahead<'_> {
                 let value = |x: f64| cost.eval(x) + lambda1 * (h[k] + x).abs();
                 let slope = |x: f64| {
                     let (f, d) = cost.eval_slope(x);
-                    (f + lambda1 * (h[k] + x).abs(), d + lambda1 * (h[k] + x).signum())
+                    (
+                        f + lambda1 * (h[k] + x).abs(),
+                        d + lambda1 * (h[k] + x).signum(),
+                    )
                 };
                 let scan = (scan, opts.scan_step_deg);
                 let starts = neighbour_starts(&st.r, k);

@@ -91,7 +91,7 @@ impl ParentCost {
     // Indexed loops over the parallel arrays of a block: the form the
     // compiler vectorises.
     #[allow(clippy::needless_range_loop)]
-    fn data(&self, c_p: &Quat, mut grad: Option<&mut Vector3<f64>>) -> f64 {
+    fn data(&self, c_p: &Quat, grad: Option<&mut Vector3<f64>>) -> f64 {
         let n = self.len();
         if n == 0 {
             return 0.0;
@@ -167,7 +167,7 @@ impl ParentCost {
             }
         }
         let n = n as f64;
-        if let Some(out) = grad.as_deref_mut() {
+        if let Some(out) = grad {
             *out = g / n;
         }
         sum / n
