@@ -193,7 +193,7 @@ impl HeadingProblem<'_> {
     /// The C-step costs: per window `Rm_i = P_i'^T R_up(-h_k) D_i`.
     pub(super) fn c_costs(&self, headings: &[f64], stride: usize) -> Vec<WindowCost> {
         self.windows
-            .iter()
+            .par_iter()
             .zip(headings)
             .map(|(w, &h)| {
                 let r = self.vertical.heading_rotation(-h);
@@ -323,16 +323,19 @@ impl CStep<'_> {
     }
 
     /// The objective without its `angle(C)` terms, and that part's gradient
-    /// in the right tangent of `q` (degrees per radian).
+    /// in the right tangent of `q` (degrees per radian). The windows are
+    /// evaluated in parallel and summed in order (the same bits for any
+    /// thread count).
     fn data_grad(&self, q: &Quat) -> (f64, Vector3<f64>) {
+        let own: Vec<(f64, Vector3<f64>)> = self.own.par_iter().map(|k| k.data_grad(q)).collect();
+        let children: Vec<(f64, Vector3<f64>)> =
+            self.children.par_iter().map(|k| k.eval_grad(q)).collect();
         let (mut f, mut g) = (0.0, Vector3::zeros());
-        for k in self.own {
-            let (fk, gk) = k.data_grad(q);
+        for (fk, gk) in own {
             f += fk;
             g += gk;
         }
-        for k in self.children {
-            let (fk, gk) = k.eval_grad(q);
+        for (fk, gk) in children {
             f += self.child_weight * fk;
             g += gk * self.child_weight;
         }
