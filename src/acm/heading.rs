@@ -15,10 +15,10 @@
 //!        + lambda1 angle(C) + lambda1 |h_k|`.
 //!
 //! Solver: block coordinate descent, alternating C over all windows (3-D,
-//! [`CStep`]: the shape-aware quasi-Newton minimiser by default, Nelder-Mead
+//! `CStep`: the shape-aware quasi-Newton minimiser by default, Nelder-Mead
 //! with [`Solver::NelderMead`]) with each `h_k` on its window (1-D on
 //! [`HeadingCost`]: a bracketing search on its derivative by default,
-//! [`slope_search`], or the pattern search on values, [`line_search`]);
+//! `slope_search`, or the pattern search on values, `line_search`);
 //! neither step can raise J. Two things make it better than
 //! plain alternation from zero: the first heading step scans the whole circle
 //! (a drift of tens of degrees is not found by a local search from the biased
@@ -67,8 +67,8 @@ pub struct HeadingOptions {
     /// Start C from the first window alone (at zero heading).
     pub first_window_start: bool,
     /// The minimiser of the C steps; with [`Solver::Gradient`] the heading
-    /// steps search on the derivative ([`slope_search`]), with
-    /// [`Solver::NelderMead`] on values ([`line_search`], the reference).
+    /// steps search on the derivative (`slope_search`), with
+    /// [`Solver::NelderMead`] on values (`line_search`, the reference).
     pub solver: Solver,
 }
 
@@ -491,9 +491,9 @@ pub(super) fn line_search(
     (x, evals)
 }
 
-/// As [`line_search`], descending on the derivative: `value` gives the cost
+/// As `line_search`, descending on the derivative: `value` gives the cost
 /// (the grid's), `slope` the cost and its derivative (per degree), from the
-/// same start as [`line_search`] ([`descend_on_slope`]). Never returns a
+/// same start as `line_search` ([`descend_on_slope`]). Never returns a
 /// point costlier than `starts[0]`.
 pub(super) fn slope_search(
     value: &dyn Fn(f64) -> f64,
