@@ -4,7 +4,10 @@
 //! - a 5-minute 13-IMU trial with `drift-centroid`, each solver;
 //! - one joint (the left knee, and the ankle below it) re-corrected after a
 //!   limit edit, each solver;
-//! - `drift-heading-centroid` against `drift-centroid`, gradient solver;
+//! - `drift-heading-centroid` with each solver (the C steps and the heading
+//!   steps; Nelder-Mead's are the previous ones), and against
+//!   `drift-centroid`: the gradient solver's (now) and Nelder-Mead's heading
+//!   fit against the gradient `drift-centroid` (before);
 //! - a 2-hour trial against 24 times the 5-minute one, gradient solver;
 //! - peak heap during a `drift-centroid` correction of 5 min, 30 min and
 //!   2 h, as a multiple of the decoded orientations (samples x IMUs x 32 bytes).
@@ -177,17 +180,14 @@ fn benches(c: &mut Criterion) {
             })
         });
     }
-    let name = "Gradient drift-heading-centroid 5 min";
-    g.bench_function(name, |b| {
-        timed(b, name, || {
-            run(
-                &five,
-                Variant::DriftHeadingCentroid,
-                &table,
-                Solver::Gradient,
-            );
-        })
-    });
+    for solver in [Solver::NelderMead, Solver::Gradient] {
+        let name = format!("{solver:?} drift-heading-centroid 5 min");
+        g.bench_function(&name, |b| {
+            timed(b, &name, || {
+                run(&five, Variant::DriftHeadingCentroid, &table, solver);
+            })
+        });
+    }
     let name = "Gradient drift-centroid 2 h";
     g.bench_function(name, |b| {
         timed(b, name, || {
@@ -198,7 +198,11 @@ fn benches(c: &mut Criterion) {
 
     let ratio = |a: &str, b: &str| mean_s(a) / mean_s(b);
     eprintln!("\n== solver ratios (mean seconds per run, 2 threads)");
-    for what in ["drift-centroid 5 min", "re-correct l_knee 5 min"] {
+    for what in [
+        "drift-centroid 5 min",
+        "re-correct l_knee 5 min",
+        "drift-heading-centroid 5 min",
+    ] {
         let (nm, gr) = (format!("NelderMead {what}"), format!("Gradient {what}"));
         eprintln!(
             "{what}: Nelder-Mead {:.3} s, gradient {:.3} s: {:.2}x faster",
@@ -207,13 +211,15 @@ fn benches(c: &mut Criterion) {
             ratio(&nm, &gr)
         );
     }
-    eprintln!(
-        "drift-heading-centroid / drift-centroid (5 min, gradient): {:.2}",
-        ratio(
-            "Gradient drift-heading-centroid 5 min",
-            "Gradient drift-centroid 5 min"
-        )
-    );
+    for solver in ["Gradient", "NelderMead"] {
+        eprintln!(
+            "drift-heading-centroid ({solver} heading fit) / drift-centroid (gradient), 5 min: {:.2}",
+            ratio(
+                &format!("{solver} drift-heading-centroid 5 min"),
+                "Gradient drift-centroid 5 min"
+            )
+        );
+    }
     eprintln!(
         "2 h / (24 x 5 min) (drift-centroid, gradient): {:.2}",
         mean_s("Gradient drift-centroid 2 h") / (24.0 * mean_s("Gradient drift-centroid 5 min"))

@@ -544,8 +544,13 @@ impl Pass<'_> {
             own: problem,
             children: &children,
         };
-        let (sol, heading, orientation) =
-            solve_heading(&trial.time_s, &lookahead, &joint.name, &joint.distal);
+        let opts = HeadingOptions::for_solver(self.settings.solver);
+        let (sol, heading, orientation) = solve_heading(
+            &trial.time_s,
+            &lookahead,
+            &opts,
+            (&joint.name, &joint.distal),
+        );
         self.windows
             .iter()
             .for_each(|_| self.progress.window_done());
@@ -812,10 +817,10 @@ enum GyroUpdate {
 fn solve_heading(
     time_s: &[f64],
     lookahead: &Lookahead,
-    joint: &str,
-    imu: &str,
+    opts: &HeadingOptions,
+    (joint, imu): (&str, &str),
 ) -> (Vec<WindowSolution>, ImuHeading, Vec<Quat>) {
-    let fit = lookahead.fit(&HeadingOptions::default());
+    let fit = lookahead.fit(opts);
     let problem = &lookahead.own;
     let c = canonical(&fit.c);
     let windows: Vec<WindowSolution> = problem

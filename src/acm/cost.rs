@@ -276,6 +276,38 @@ impl LimitTerms {
         ex + ey + ez
     }
 
+    /// As [`LimitTerms::excursion`], with the excursion's derivative
+    /// (degrees per radian) along a path on which the entries move at rates
+    /// `d` (per radian): `d phi = (r22 d21 - r21 d22) / rho`,
+    /// `d theta = -d20 / sqrt(rho)`, `d psi = (r00 d10 - r10 d00) / sigma`,
+    /// `rho = r21^2 + r22^2`, `sigma = r00^2 + r10^2`. At a kink it is the
+    /// derivative of one side.
+    #[inline(always)]
+    pub(super) fn excursion_along(
+        &self,
+        [r00, r10, r20, r21, r22]: [f64; 5],
+        [d00, d10, d20, d21, d22]: [f64; 5],
+    ) -> (f64, f64) {
+        let (ex, sx) = self.x.excursion_slope(r21, r22);
+        let (ey, sy) = self.y.excursion_slope(r20);
+        let (ez, sz) = self.z.excursion_slope(r10, r00);
+        let mut slope = 0.0;
+        let rho = r21 * r21 + r22 * r22;
+        if sx != 0.0 && rho > 0.0 {
+            slope += sx * (r22 * d21 - r21 * d22) / rho;
+        }
+        if sy != 0.0 && rho > 0.0 {
+            slope -= sy * d20 / rho.sqrt();
+        }
+        if sz != 0.0 {
+            let sigma = r00 * r00 + r10 * r10;
+            if sigma > 0.0 {
+                slope += sz * (r00 * d10 - r10 * d00) / sigma;
+            }
+        }
+        (ex + ey + ez, slope * DEG)
+    }
+
     /// `lambda2 * sum RMSq` over quaternions held as component arrays `q`
     /// (`[w, x, y, z]`) dotted with `p`. With `weighted`, adds to it the sum
     /// of `d(lambda2 RMSq_i)/d(d_i) * q_i` (`d_i = q_i . p`), from which the
@@ -326,18 +358,13 @@ impl LimitTerms {
         self.lambda2 * rmsq_of_dot(d)
     }
 
-    /// The centroid terms summed over quaternions `qs` (`[w, x, y, z]`) dotted
-    /// with `p` (0 without the term).
-    pub(super) fn centroid_sum<'a>(&self, qs: impl Iterator<Item = &'a [f64; 4]>, p: &Quat) -> f64 {
-        if self.centroid.is_none() {
-            return 0.0;
-        }
-        let p = [p.w, p.i, p.j, p.k];
-        let mut sum = 0.0;
-        for q in qs {
-            sum += rmsq_of_dot(q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3] * p[3]);
-        }
-        self.lambda2 * sum
+    /// [`LimitTerms::centroid_term`] and its derivative along a path on which
+    /// `d` moves at rate `dd`; 0 at the centroid itself (the cone's tip).
+    #[inline(always)]
+    pub(super) fn centroid_term_along(&self, d: f64, dd: f64) -> (f64, f64) {
+        let r = rmsq_of_dot(d);
+        let slope = if r > 1e-12 { -d.signum() * dd / r } else { 0.0 };
+        (self.lambda2 * r, self.lambda2 * slope)
     }
 }
 
@@ -359,12 +386,6 @@ pub(super) fn matrix_vectors(q: &Quat, rows: bool) -> [[f64; 3]; 3] {
         }
     };
     [v(0), v(1), v(2)]
-}
-
-/// `a . b` of 3-vectors.
-#[inline(always)]
-pub(super) fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// The samples of a window laid out for the evaluation loop (structure of
@@ -397,7 +418,7 @@ impl Samples {
 
 /// Samples evaluated together: the matrix products of a block are formed in
 /// one loop the compiler can vectorise, then the range tests run over them.
-const BLOCK: usize = 64;
+pub(super) const BLOCK: usize = 64;
 
 /// The cost of one joint over one window, prepared for many evaluations.
 #[derive(Debug, Clone)]

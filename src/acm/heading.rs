@@ -14,9 +14,12 @@
 //! `e_k = (1/n_k) sum_{i in k} (Ex + Ey + Ez + lambda2 RMSq)(P_i'^T R_up(-h_k) D_i C)
 //!        + lambda1 angle(C) + lambda1 |h_k|`.
 //!
-//! Solver: block coordinate descent, alternating C over all windows (3-D
-//! Nelder-Mead, [`minimise`]) with each `h_k` on its window (1-D pattern search
-//! on [`HeadingCost`]); neither step can raise J. Two things make it better than
+//! Solver: block coordinate descent, alternating C over all windows (3-D,
+//! `CStep`: the shape-aware quasi-Newton minimiser by default, Nelder-Mead
+//! with [`Solver::NelderMead`]) with each `h_k` on its window (1-D on
+//! [`HeadingCost`]: a bracketing search on its derivative by default,
+//! `slope_search`, or the pattern search on values, `line_search`);
+//! neither step can raise J. Two things make it better than
 //! plain alternation from zero: the first heading step scans the whole circle
 //! (a drift of tens of degrees is not found by a local search from the biased
 //! first C), and the early rounds run on every `coarse_stride`-th sample before
@@ -30,11 +33,15 @@
 
 use super::cost::WindowCost;
 use super::heading_cost::HeadingCost;
-use super::minimise::{minimise, MinimiseOptions};
+use super::minimise::{
+    minimise, minimise_shaped, MinimiseOptions, ShapedCost, ShapedOptions, Solution, Solver,
+};
+use super::parent_cost::ParentCost;
 use super::window::Window;
 use crate::limits::JointLimits;
 use crate::rotation::Quat;
 use crate::vertical::Vertical;
+use nalgebra::Vector3;
 use rayon::prelude::*;
 
 /// Tuning of the heading solver.
@@ -59,6 +66,10 @@ pub struct HeadingOptions {
     pub tol: f64,
     /// Start C from the first window alone (at zero heading).
     pub first_window_start: bool,
+    /// The minimiser of the C steps; with [`Solver::Gradient`] the heading
+    /// steps search on the derivative (`slope_search`), with
+    /// [`Solver::NelderMead`] on values (`line_search`, the reference).
+    pub solver: Solver,
 }
 
 impl Default for HeadingOptions {
@@ -73,6 +84,7 @@ impl Default for HeadingOptions {
             coarse_tol: 1e-5,
             tol: 1e-7,
             first_window_start: true,
+            solver: Solver::default(),
         }
     }
 }
@@ -82,23 +94,34 @@ impl HeadingOptions {
     /// scan)` does one round on every `stride`-th sample (`scan`: scan the
     /// whole circle for each heading; the very first round only, when
     /// `global_scan`) and returns the objective; a phase ends when a round
-    /// gains less than its tolerance or its rounds run out.
-    pub(super) fn run_phases(&self, mut round: impl FnMut(usize, bool) -> f64) {
+    /// gains less than its tolerance or its rounds run out. Returns the last
+    /// round's objective.
+    pub(super) fn run_phases(&self, mut round: impl FnMut(usize, bool) -> f64) -> f64 {
         let phases = [
             (self.coarse_stride, self.coarse_rounds, self.coarse_tol),
             (self.fine_stride, self.fine_rounds, self.tol),
         ];
         let mut first = true;
+        let mut j = f64::INFINITY;
         for (stride, max_rounds, tol) in phases {
             let mut last = f64::INFINITY;
             for _ in 0..max_rounds {
-                let j = round(stride, self.global_scan && first);
+                j = round(stride, self.global_scan && first);
                 first = false;
                 if last - j < tol {
                     break;
                 }
                 last = j;
             }
+        }
+        j
+    }
+
+    /// The default options with `solver`.
+    pub fn for_solver(solver: Solver) -> Self {
+        HeadingOptions {
+            solver,
+            ..HeadingOptions::default()
         }
     }
 
@@ -115,6 +138,7 @@ impl HeadingOptions {
             coarse_tol: 1e-9,
             tol: 1e-9,
             first_window_start: false,
+            solver: Solver::default(),
         }
     }
 }
@@ -138,6 +162,11 @@ pub struct HeadingFit {
     pub rounds: usize,
     /// Samples evaluated in all, over every step (the solver's work).
     pub sample_evaluations: usize,
+    /// The objective at the solution as the last round measured it (on every
+    /// `fine_stride`-th sample): `J(C, h)` plus, with the lookahead, the child
+    /// joints' weighted terms at their auxiliary fit (degrees; what the
+    /// solvers are compared on).
+    pub objective: f64,
 }
 
 impl HeadingFit {
@@ -164,7 +193,7 @@ impl HeadingProblem<'_> {
     /// The C-step costs: per window `Rm_i = P_i'^T R_up(-h_k) D_i`.
     pub(super) fn c_costs(&self, headings: &[f64], stride: usize) -> Vec<WindowCost> {
         self.windows
-            .iter()
+            .par_iter()
             .zip(headings)
             .map(|(w, &h)| {
                 let r = self.vertical.heading_rotation(-h);
@@ -191,17 +220,6 @@ impl HeadingProblem<'_> {
         )
     }
 
-    /// `J(C, h)` on every `stride`-th sample.
-    pub(super) fn total_at(&self, c: &Quat, headings: &[f64], stride: usize) -> f64 {
-        let costs: Vec<f64> = self
-            .windows
-            .par_iter()
-            .zip(headings)
-            .map(|(w, &h)| self.heading_cost(w, c, stride).eval(h))
-            .collect();
-        costs.iter().sum()
-    }
-
     /// `e_k(C, h_k)` per window at full resolution.
     pub fn window_costs(&self, c: &Quat, headings: &[f64]) -> Vec<f64> {
         self.windows
@@ -223,7 +241,7 @@ impl HeadingProblem<'_> {
             sample_evaluations: 0,
             first_window_start: opts.first_window_start,
         };
-        opts.run_phases(|stride, scan| state.round(self, stride, scan, opts.scan_step_deg));
+        let objective = opts.run_phases(|stride, scan| state.round(self, stride, scan, opts));
         let Alternation {
             c,
             h,
@@ -238,6 +256,7 @@ impl HeadingProblem<'_> {
         HeadingFit {
             c,
             headings_deg: h,
+            objective,
             window_costs,
             window_costs_uncorrected,
             window_evaluations,
@@ -272,6 +291,108 @@ pub(super) fn c_step_options(round: usize, stride: usize) -> MinimiseOptions {
     nm
 }
 
+/// The quasi-Newton options of a C step in round `round` (from 1) on every
+/// `stride`-th sample: as [`c_step_options`], a warm first step after the
+/// first round and a coarse tolerance in the coarse phase.
+fn c_step_shaped_options(round: usize, stride: usize) -> ShapedOptions {
+    let mut o = ShapedOptions::default();
+    if round > 1 {
+        o.initial_step_rad = WARM_STEP_RAD;
+    }
+    if stride > 1 {
+        o.tol_x_rad = COARSE_TOL_RAD;
+        o.tol_f_rel = 1e-9;
+    }
+    o
+}
+
+/// The objective of a C step (degrees): the sum of window costs `own`, each
+/// with its `lambda1 * angle(C)`, plus `child_weight` times the sum of the
+/// child joints' costs as functions of C ([`ParentCost`], no penalty).
+pub(super) struct CStep<'a> {
+    pub own: &'a [WindowCost],
+    pub children: &'a [ParentCost],
+    pub child_weight: f64,
+}
+
+impl CStep<'_> {
+    /// The objective at `q`.
+    fn value(&self, q: &Quat) -> f64 {
+        self.own.iter().map(|k| k.eval(q)).sum::<f64>()
+            + self.child_weight * self.children.iter().map(|k| k.eval(q)).sum::<f64>()
+    }
+
+    /// The objective without its `angle(C)` terms, and that part's gradient
+    /// in the right tangent of `q` (degrees per radian). The windows are
+    /// evaluated in parallel and summed in order (the same bits for any
+    /// thread count).
+    fn data_grad(&self, q: &Quat) -> (f64, Vector3<f64>) {
+        let own: Vec<(f64, Vector3<f64>)> = self.own.par_iter().map(|k| k.data_grad(q)).collect();
+        let children: Vec<(f64, Vector3<f64>)> =
+            self.children.par_iter().map(|k| k.eval_grad(q)).collect();
+        let (mut f, mut g) = (0.0, Vector3::zeros());
+        for (fk, gk) in own {
+            f += fk;
+            g += gk;
+        }
+        for (fk, gk) in children {
+            f += self.child_weight * fk;
+            g += gk * self.child_weight;
+        }
+        (f, g)
+    }
+
+    /// Samples in one evaluation of the objective.
+    pub(super) fn samples(&self) -> usize {
+        self.own.iter().map(WindowCost::len).sum::<usize>()
+            + self.children.iter().map(ParentCost::len).sum::<usize>()
+    }
+
+    /// Minimises the objective from `start` with `solver`, tuned for round
+    /// `round` (from 1) on every `stride`-th sample.
+    pub(super) fn solve(
+        &self,
+        start: &Quat,
+        round: usize,
+        stride: usize,
+        solver: Solver,
+    ) -> Solution {
+        match solver {
+            Solver::NelderMead => minimise(
+                &|q| self.value(q),
+                &[*start],
+                &c_step_options(round, stride),
+            ),
+            Solver::Gradient => {
+                let data = |q: &Quat| self.data_grad(q);
+                let lambda1 = self.own.first().map_or(0.0, WindowCost::lambda1);
+                let shaped = ShapedCost {
+                    data: &data,
+                    cone: lambda1 * self.own.len() as f64,
+                };
+                minimise_shaped(&shaped, &[*start], &c_step_shaped_options(round, stride))
+            }
+        }
+    }
+}
+
+/// Minimises a window's 1-D heading cost from `starts` (the current value
+/// first) with the search of `solver`: `value` gives the cost, `slope` the
+/// cost and its derivative (per degree). Returns the heading and the
+/// evaluations spent.
+pub(super) fn heading_search(
+    value: &dyn Fn(f64) -> f64,
+    slope: &dyn Fn(f64) -> (f64, f64),
+    starts: &[f64],
+    (scan, scan_step): (bool, f64),
+    solver: Solver,
+) -> (f64, usize) {
+    match solver {
+        Solver::NelderMead => line_search(value, starts, scan, scan_step),
+        Solver::Gradient => slope_search(value, slope, starts, scan, scan_step),
+    }
+}
+
 /// The state of the alternation.
 struct Alternation {
     c: Quat,
@@ -286,7 +407,13 @@ struct Alternation {
 impl Alternation {
     /// One C step then one heading step on every `stride`-th sample; returns J
     /// there. Neither step raises J.
-    fn round(&mut self, p: &HeadingProblem, stride: usize, scan: bool, scan_step: f64) -> f64 {
+    fn round(
+        &mut self,
+        p: &HeadingProblem,
+        stride: usize,
+        scan: bool,
+        opts: &HeadingOptions,
+    ) -> f64 {
         self.rounds += 1;
         let mut costs = p.c_costs(&self.h, stride);
         if self.rounds == 1 && self.first_window_start {
@@ -294,28 +421,38 @@ impl Alternation {
             // from the first window alone, then every window's heading from it.
             costs.truncate(1);
         }
-        let total = |q: &Quat| costs.iter().map(|k| k.eval(q)).sum::<f64>();
-        let s = minimise(&total, &[self.c], &c_step_options(self.rounds, stride));
+        let step = CStep {
+            own: &costs,
+            children: &[],
+            child_weight: 0.0,
+        };
+        let s = step.solve(&self.c, self.rounds, stride, opts.solver);
         self.c_evaluations += s.evaluations;
-        self.sample_evaluations += s.evaluations * costs.iter().map(WindowCost::len).sum::<usize>();
+        self.sample_evaluations += s.evaluations * step.samples();
         self.c = s.c;
         let (c, h) = (&self.c, &self.h);
-        let steps: Vec<(f64, usize, usize)> = (0..h.len())
+        let steps: Vec<(f64, usize, usize, f64)> = (0..h.len())
             .into_par_iter()
             .map(|k| {
                 let cost = p.heading_cost(&p.windows[k], c, stride);
                 let mut starts = vec![h[k]];
                 starts.extend([k.wrapping_sub(1), k + 1].iter().filter_map(|&j| h.get(j)));
-                let (hk, e) = line_search(&|x| cost.eval(x), &starts, scan, scan_step);
-                (hk, e, e * cost.len())
+                let value = |x: f64| cost.eval(x);
+                let slope = |x: f64| cost.eval_slope(x);
+                let scan = (scan, opts.scan_step_deg);
+                let (hk, e) = heading_search(&value, &slope, &starts, scan, opts.solver);
+                (hk, e, e * cost.len(), cost.eval(hk))
             })
             .collect();
-        for (k, (hk, e, work)) in steps.into_iter().enumerate() {
+        let mut costs = Vec::with_capacity(steps.len());
+        for (k, (hk, e, work, cost)) in steps.into_iter().enumerate() {
             self.h[k] = hk;
             self.window_evaluations[k] += e;
             self.sample_evaluations += work;
+            costs.push(cost);
         }
-        p.total_at(&self.c, &self.h, stride)
+        // J, from the window costs the heading step built.
+        costs.iter().sum()
     }
 }
 
@@ -334,6 +471,68 @@ pub(super) fn line_search(
         evals += 1;
         f(x)
     };
+    let (mut x, mut fx) = best_start(&mut eval, starts, scan, scan_step);
+    let mut step = first_step(scan, scan_step);
+    while step > SEARCH_TOL_DEG {
+        let up = eval(x + step);
+        if up < fx {
+            (x, fx) = (x + step, up);
+            step *= 2.0;
+            continue;
+        }
+        let down = eval(x - step);
+        if down < fx {
+            (x, fx) = (x - step, down);
+            step *= 2.0;
+            continue;
+        }
+        step *= 0.5;
+    }
+    (x, evals)
+}
+
+/// As `line_search`, descending on the derivative: `value` gives the cost
+/// (the grid's), `slope` the cost and its derivative (per degree), from the
+/// same start as `line_search` ([`descend_on_slope`]). Never returns a
+/// point costlier than `starts[0]`.
+pub(super) fn slope_search(
+    value: &dyn Fn(f64) -> f64,
+    slope: &dyn Fn(f64) -> (f64, f64),
+    starts: &[f64],
+    scan: bool,
+    scan_step: f64,
+) -> (f64, usize) {
+    let mut evals = 0;
+    let mut eval = |x: f64| {
+        evals += 1;
+        value(x)
+    };
+    let (x0, _) = best_start(&mut eval, starts, scan, scan_step);
+    let (x, more) = descend_on_slope(slope, x0, first_step(scan, scan_step));
+    (x, evals + more)
+}
+
+/// Where a 1-D heading search ends: a step or bracket this narrow, degrees.
+const SEARCH_TOL_DEG: f64 = 1e-6;
+
+/// The first step of a 1-D heading search from its start, degrees.
+fn first_step(scan: bool, scan_step: f64) -> f64 {
+    if scan {
+        scan_step / 2.0
+    } else {
+        0.5
+    }
+}
+
+/// The cheapest of `starts` and, with `scan`, of the two best local minima
+/// of a grid over the whole circle (`scan_step` degrees apart); the first
+/// on ties. Returns it and its cost.
+fn best_start(
+    eval: &mut impl FnMut(f64) -> f64,
+    starts: &[f64],
+    scan: bool,
+    scan_step: f64,
+) -> (f64, f64) {
     let mut cands: Vec<(f64, f64)> = starts.iter().map(|&x| (x, eval(x))).collect();
     if scan {
         let steps = (360.0 / scan_step).round() as i64;
@@ -353,30 +552,94 @@ pub(super) fn line_search(
         minima.sort_by(|a, b| a.1.total_cmp(&b.1));
         cands.extend(minima.into_iter().take(2));
     }
-    // Descend from the cheapest candidate only (the first on ties).
     let (mut x, mut fx) = cands[0];
     for &(c, fc) in &cands[1..] {
         if fc < fx {
             (x, fx) = (c, fc);
         }
     }
-    let mut step = if scan { scan_step / 2.0 } else { 0.5 };
-    while step > 1e-6 {
-        let up = eval(x + step);
-        if up < fx {
-            (x, fx) = (x + step, up);
-            step *= 2.0;
-            continue;
-        }
-        let down = eval(x - step);
-        if down < fx {
-            (x, fx) = (x - step, down);
-            step *= 2.0;
-            continue;
-        }
-        step *= 0.5;
+    (x, fx)
+}
+
+/// Most evaluations of one [`descend_on_slope`].
+const MAX_SLOPE_EVALS: usize = 200;
+
+/// A point of a 1-D descent: position (degrees), value, and derivative along
+/// the descent's direction.
+#[derive(Clone, Copy)]
+struct Probe {
+    x: f64,
+    f: f64,
+    s: f64,
+}
+
+/// Descends a 1-D cost from `x0`, `f` giving its value and derivative (per
+/// degree; one side's at a kink): steps downhill doubling from `step` until
+/// the derivative turns or the value rises, which brackets a local minimum,
+/// then narrows the bracket to [`SEARCH_TOL_DEG`] with secant steps on the
+/// derivative, a bisection whenever one fails to halve it, and a probe just
+/// past the low end when only the far end moves (a minimum on a kink, such
+/// as `h = 0` of `lambda1 |h|`). Assumes the cost continuous. Returns the
+/// lowest point evaluated (never costlier than `x0`) and the evaluations.
+fn descend_on_slope(f: &dyn Fn(f64) -> (f64, f64), x0: f64, step: f64) -> (f64, usize) {
+    let (f0, d0) = f(x0);
+    let mut evals = 1;
+    if d0 == 0.0 || !d0.is_finite() {
+        return (x0, evals);
     }
-    (x, evals)
+    let dir = -d0.signum();
+    let mut best = (x0, f0);
+    let mut probe = |x: f64, evals: &mut usize| {
+        *evals += 1;
+        let (fx, dx) = f(x);
+        if fx < best.1 {
+            best = (x, fx);
+        }
+        Probe {
+            x,
+            f: fx,
+            s: dx * dir,
+        }
+    };
+    // `lo`: the downhill end (slope along `dir` below zero); `hi`: beyond the minimum.
+    let mut lo = Probe {
+        x: x0,
+        f: f0,
+        s: d0 * dir,
+    };
+    let mut t = step;
+    let mut hi = loop {
+        let p = probe(lo.x + dir * t, &mut evals);
+        if p.f > lo.f || p.s >= 0.0 || !p.f.is_finite() {
+            break p;
+        }
+        if evals >= MAX_SLOPE_EVALS {
+            return (best.0, evals);
+        }
+        lo = p;
+        t *= 2.0;
+    };
+    let (mut secant, mut far_moves) = (true, 0);
+    while (hi.x - lo.x).abs() > SEARCH_TOL_DEG && evals < MAX_SLOPE_EVALS {
+        let width = hi.x - lo.x;
+        let x = if far_moves >= 2 {
+            lo.x + 0.5 * SEARCH_TOL_DEG * dir
+        } else if secant && hi.s >= 0.0 && hi.f.is_finite() {
+            lo.x + width * (lo.s / (lo.s - hi.s)).clamp(0.05, 0.95)
+        } else {
+            lo.x + 0.5 * width
+        };
+        let p = probe(x, &mut evals);
+        if p.f > lo.f || p.s >= 0.0 {
+            hi = p;
+            far_moves += 1;
+        } else {
+            lo = p;
+            far_moves = 0;
+        }
+        secant = (hi.x - lo.x).abs() <= 0.5 * width.abs();
+    }
+    (best.0, evals)
 }
 
 /// The heading at each sample: `h_1` before the first centre, `h_N` from the last
@@ -503,6 +766,33 @@ mod tests {
         let (local, _) = line_search(&f, &[0.0], false, 4.0);
         assert!(f(x) <= f(local), "{x} vs {local}");
         assert!(f(x) < f(0.0));
+    }
+
+    #[test]
+    fn slope_search_finds_smooth_kinked_and_far_minima() {
+        // A smooth bowl, from 0 without the scan.
+        let bowl = |x: f64| ((x - 12.3).powi(2), 2.0 * (x - 12.3));
+        let (x, _) = slope_search(&|x| bowl(x).0, &bowl, &[0.0], false, 4.0);
+        assert!((x - 12.3).abs() < 1e-6, "{x}");
+        // A minimum on the kink of lambda1 |h| at 0 (the common case of no
+        // drift): found exactly, as the point evaluated there.
+        let cone = |x: f64| (0.05 * x.abs() + 0.01 * x * x, 0.05 * x.signum() + 0.02 * x);
+        let (x, _) = slope_search(&|x| cone(x).0, &cone, &[3.0], false, 4.0);
+        assert!(x.abs() < 1e-6, "{x}");
+        let (x, _) = slope_search(&|x| cone(x).0, &cone, &[0.0], false, 4.0);
+        assert_eq!(x, 0.0);
+        // A far kinked minimum behind a ripple: with the scan, as good as the
+        // pattern search.
+        let far = |x: f64| {
+            let f = (x - 100.0).abs() + 0.05 * x.abs() + 10.0 * ((x / 7.0).sin() + 1.0);
+            let d = (x - 100.0).signum() + 0.05 * x.signum() + 10.0 / 7.0 * (x / 7.0).cos();
+            (f, d)
+        };
+        let value = |x: f64| far(x).0;
+        let (x, evals) = slope_search(&value, &far, &[0.0], true, 4.0);
+        let (y, pattern_evals) = line_search(&value, &[0.0], true, 4.0);
+        assert!(value(x) <= value(y) + 1e-9, "{x} {y}");
+        assert!(evals < pattern_evals, "{evals} vs {pattern_evals}");
     }
 
     #[test]

@@ -17,14 +17,10 @@
 use super::cost::LimitTerms;
 use crate::limits::JointLimits;
 use crate::rotation::{angle_deg, Quat};
-use nalgebra::{Matrix3, Quaternion};
+use nalgebra::{Quaternion, Vector3};
 
 /// The entries `r00, r10, r20, r21, r22` of a rotation matrix.
 type Entries = [f64; 5];
-
-fn entries(m: &Matrix3<f64>) -> Entries {
-    [m[(0, 0)], m[(1, 0)], m[(2, 0)], m[(2, 1)], m[(2, 2)]]
-}
 
 /// One sample prepared for evaluation at any heading.
 #[derive(Debug, Clone, Copy)]
@@ -34,6 +30,46 @@ struct Sample {
     m2: Entries,
     /// `a . qc` and `b . qc` (0 without centroid term).
     centroid_dots: [f64; 2],
+}
+
+impl Sample {
+    /// The sample of parent orientation `p` and right factor `b = G_R_dist C`:
+    /// the entries of `P^T X` for `X = B, -K B, K^2 B`, formed from the rows of
+    /// `P^T` (the columns of `P`) and the columns of `B` turned by `up x`
+    /// (`K v = up x v`), and the centroid's two dot products.
+    fn new(p: &Quat, b: &Quat, up: &Vector3<f64>, centroid: Option<&Quat>) -> Self {
+        let pm = p.to_rotation_matrix().into_inner();
+        let bm = b.to_rotation_matrix().into_inner();
+        let rows = [pm.column(0), pm.column(1), pm.column(2)];
+        let cols: [Vector3<f64>; 3] = std::array::from_fn(|j| bm.column(j).into_owned());
+        let kb = cols.map(|v| up.cross(&v));
+        let k2b = kb.map(|v| up.cross(&v));
+        let entries = |x: &[Vector3<f64>; 3], sign: f64| -> Entries {
+            [
+                sign * rows[0].dot(&x[0]),
+                sign * rows[1].dot(&x[0]),
+                sign * rows[2].dot(&x[0]),
+                sign * rows[2].dot(&x[1]),
+                sign * rows[2].dot(&x[2]),
+            ]
+        };
+        let centroid_dots = match centroid {
+            Some(qc) => {
+                let pt = p.inverse().into_inner();
+                let minus_up = Quaternion::new(0.0, -up[0], -up[1], -up[2]);
+                let qa = pt * b.into_inner();
+                let qb = pt * minus_up * b.into_inner();
+                [qa.coords.dot(&qc.coords), qb.coords.dot(&qc.coords)]
+            }
+            None => [0.0, 0.0],
+        };
+        Sample {
+            m0: entries(&cols, 1.0),
+            m1: entries(&kb, -1.0),
+            m2: entries(&k2b, 1.0),
+            centroid_dots,
+        }
+    }
 }
 
 /// The cost of one joint over one window as a function of the heading correction.
@@ -60,40 +96,18 @@ impl HeadingCost {
         lambda1: f64,
         stride: usize,
     ) -> Self {
-        let k = Matrix3::new(
-            0.0, -up[2], up[1], //
-            up[2], 0.0, -up[0], //
-            -up[1], up[0], 0.0,
-        );
-        let k2 = k * k;
+        let up = Vector3::new(up[0], up[1], up[2]);
         let terms = LimitTerms::new(limits);
         let centroid = terms.centroid;
-        let minus_up = Quaternion::new(0.0, -up[0], -up[1], -up[2]);
         let samples = parent
             .iter()
             .zip(child)
             .step_by(stride.max(1))
             .map(|(p, d)| {
                 // In the limits' axes `Rt` is `(P Q)^T R_up(-h) (D C Q)`.
-                let (b, pt) = match &limits.axes {
-                    Some(a) => (d * c * a.q, (p * a.q).inverse()),
-                    None => (d * c, p.inverse()),
-                };
-                let pm = pt.to_rotation_matrix().into_inner();
-                let bm = b.to_rotation_matrix().into_inner();
-                let centroid_dots = match centroid {
-                    Some(qc) => {
-                        let qa = pt.into_inner() * b.into_inner();
-                        let qb = pt.into_inner() * minus_up * b.into_inner();
-                        [qa.coords.dot(&qc.coords), qb.coords.dot(&qc.coords)]
-                    }
-                    None => [0.0, 0.0],
-                };
-                Sample {
-                    m0: entries(&(pm * bm)),
-                    m1: entries(&(-(pm * k * bm))),
-                    m2: entries(&(pm * k2 * bm)),
-                    centroid_dots,
+                match &limits.axes {
+                    Some(a) => Sample::new(&(p * a.q), &(d * c * a.q), &up, centroid.as_ref()),
+                    None => Sample::new(p, &(d * c), &up, centroid.as_ref()),
                 }
             })
             .collect();
@@ -137,6 +151,43 @@ impl HeadingCost {
         }
         sum / self.samples.len() as f64 + penalty
     }
+
+    /// [`HeadingCost::eval`] and its derivative in `h` (degrees per degree),
+    /// from `dRt/dh = cos(h) M1 + sin(h) M2` (per radian) and
+    /// `dq/dh = (-sin(h/2) a + cos(h/2) b) / 2`. At a kink (a sample on a
+    /// limit, `h = 0`) it is the derivative of one side (`+lambda1` at `h = 0`).
+    pub fn eval_slope(&self, h_deg: f64) -> (f64, f64) {
+        let penalty = self.c_penalty + self.lambda1 * h_deg.abs();
+        let penalty_slope = self.lambda1 * h_deg.signum();
+        if self.samples.is_empty() {
+            return (penalty, penalty_slope);
+        }
+        let (s, c) = h_deg.to_radians().sin_cos();
+        let v = 1.0 - c;
+        let (sh, ch) = (0.5 * h_deg.to_radians()).sin_cos();
+        let centroid = self.terms.centroid.is_some();
+        let (mut sum, mut slope) = (0.0, 0.0);
+        for p in &self.samples {
+            let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
+            let d = |j: usize| c * p.m1[j] + s * p.m2[j];
+            let (e, de) = self.terms.excursion_along(
+                [r(0), r(1), r(2), r(3), r(4)],
+                [d(0), d(1), d(2), d(3), d(4)],
+            );
+            sum += e;
+            slope += de;
+            if centroid {
+                let [a, b] = p.centroid_dots;
+                let (e, de) = self
+                    .terms
+                    .centroid_term_along(ch * a + sh * b, 0.5 * (ch * b - sh * a));
+                sum += e;
+                slope += de;
+            }
+        }
+        let n = self.samples.len() as f64;
+        (sum / n + penalty, (slope / n).to_radians() + penalty_slope)
+    }
 }
 
 #[cfg(test)]
@@ -172,6 +223,62 @@ mod tests {
                 assert!((fast - direct).abs() < 1e-9, "h {h}: {fast} vs {direct}");
             }
         }
+    }
+
+    #[test]
+    fn heading_slope_matches_finite_differences() {
+        let shoulder = JointLimits {
+            range_deg: [[-10.0, 100.0], [-40.0, 60.0], [-70.0, 70.0]],
+            centroid_deg: Some([47.0, -1.0, -31.0]),
+            lambda2: 30.0,
+            axes: None,
+        };
+        let knee = JointLimits {
+            range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
+            centroid_deg: None,
+            lambda2: 0.0,
+            axes: None,
+        };
+        // In every test axes (the segment frames', proper and mirrored ones).
+        let all: Vec<JointLimits> = [shoulder, knee]
+            .into_iter()
+            .flat_map(|l| {
+                test_axes()
+                    .into_iter()
+                    .map(move |axes| JointLimits { axes, ..l })
+            })
+            .collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let parent: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
+        let child: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 180.0)).collect();
+        let mut near_kink = 0;
+        for limits in &all {
+            let c = random_quat(&mut rng, 40.0);
+            let cost = HeadingCost::new(&parent, &child, &c, [0.0, 0.0, 1.0], limits, 0.05, 1);
+            for h in [-170.0, -33.3, 4.5, 17.0, 90.2] {
+                let (f, slope) = cost.eval_slope(h);
+                assert_eq!(f, cost.eval(h));
+                // One-sided differences over 1e-6 deg; a kink within the step
+                // makes them disagree, and the point is skipped.
+                let step = 1e-6;
+                let up = (cost.eval(h + step) - f) / step;
+                let down = (f - cost.eval(h - step)) / step;
+                let tol = 1e-4 * (1.0 + slope.abs());
+                if (up - down).abs() > tol {
+                    near_kink += 1;
+                    continue;
+                }
+                assert!(
+                    (0.5 * (up + down) - slope).abs() < tol,
+                    "h {h}: {up} vs {slope}"
+                );
+            }
+        }
+        let points = 5 * all.len();
+        assert!(
+            near_kink * 5 < points,
+            "{near_kink} of {points} near a kink"
+        );
     }
 
     #[test]

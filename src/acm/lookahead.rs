@@ -40,9 +40,8 @@
 //! yet), as the solver without lookahead does.
 
 use super::cost::WindowCost;
-use super::heading::{c_step_options, line_search, HeadingFit, HeadingOptions, HeadingProblem};
+use super::heading::{heading_search, CStep, HeadingFit, HeadingOptions, HeadingProblem};
 use super::heading_cost::HeadingCost;
-use super::minimise::minimise;
 use super::parent_cost::ParentCost;
 use super::window::Window;
 use crate::limits::JointLimits;
@@ -113,12 +112,13 @@ impl Lookahead<'_> {
             rounds: 0,
             sample_evaluations: 0,
         };
-        opts.run_phases(|stride, scan| self.round(&mut s, stride, scan, opts));
+        let objective = opts.run_phases(|stride, scan| self.round(&mut s, stride, scan, opts));
         let window_costs = self.own.window_costs(&s.c, &s.h);
         let window_costs_uncorrected = self.own.window_costs(&Quat::identity(), &vec![0.0; n]);
         HeadingFit {
             c: s.c,
             headings_deg: s.h,
+            objective,
             window_costs,
             window_costs_uncorrected,
             window_evaluations: s.window_evaluations,
@@ -133,14 +133,17 @@ impl Lookahead<'_> {
     fn round(&self, s: &mut State, stride: usize, scan: bool, opts: &HeadingOptions) -> f64 {
         s.rounds += 1;
         let first = s.rounds == 1;
-        self.c_step(s, stride, first && opts.first_window_start);
-        self.heading_step(s, stride, scan, opts.scan_step_deg);
+        self.c_step(s, stride, first && opts.first_window_start, opts);
+        let own = self.heading_step(s, stride, scan, opts);
+        let mut children = Vec::with_capacity(self.children.len() * s.h.len());
         for j in 0..self.children.len() {
             let fixed = self.fixed_parent(&s.c);
-            self.child_c_step(s, j, &fixed, stride);
-            self.child_heading_step(s, j, &fixed, stride, scan, opts.scan_step_deg);
+            self.child_c_step(s, j, &fixed, stride, opts);
+            children.extend(self.child_heading_step(s, j, &fixed, (stride, scan), opts));
         }
-        self.total_at(s, stride)
+        // J from the window costs the steps built: the IMU's own terms do not
+        // change after its heading step, nor child j's after its own.
+        own.iter().sum::<f64>() + CHILD_WEIGHT * children.iter().sum::<f64>()
     }
 
     /// `X_i C`: the IMU corrected but for its heading, per sample.
@@ -150,7 +153,7 @@ impl Lookahead<'_> {
 
     /// The C step: the IMU's own windows plus, after the first round, every
     /// child joint's (the child terms hold no penalty of C).
-    fn c_step(&self, s: &mut State, stride: usize, first_window_only: bool) {
+    fn c_step(&self, s: &mut State, stride: usize, first_window_only: bool, opts: &HeadingOptions) {
         let mut own = self.own.c_costs(&s.h, stride);
         let mut children: Vec<ParentCost> = Vec::new();
         if s.rounds == 1 {
@@ -171,15 +174,14 @@ impl Lookahead<'_> {
                 })
                 .collect();
         }
-        let total = |q: &Quat| {
-            own.iter().map(|k| k.eval(q)).sum::<f64>()
-                + CHILD_WEIGHT * children.iter().map(|k| k.eval(q)).sum::<f64>()
+        let step = CStep {
+            own: &own,
+            children: &children,
+            child_weight: CHILD_WEIGHT,
         };
-        let m = minimise(&total, &[s.c], &c_step_options(s.rounds, stride));
-        let samples = own.iter().map(WindowCost::len).sum::<usize>()
-            + children.iter().map(ParentCost::len).sum::<usize>();
+        let m = step.solve(&s.c, s.rounds, stride, opts.solver);
         s.c_evaluations += m.evaluations;
-        s.sample_evaluations += m.evaluations * samples;
+        s.sample_evaluations += m.evaluations * step.samples();
         s.c = m.c;
     }
 
@@ -210,29 +212,61 @@ impl Lookahead<'_> {
             .sum()
     }
 
+    /// [`Lookahead::children_penalty`] and its derivative in `h` (one side's
+    /// at a kink, as `signum`).
+    fn children_penalty_slope(&self, s: &State, k: usize, h: f64) -> (f64, f64) {
+        let w = CHILD_WEIGHT * self.own.lambda1;
+        let slope = s.children.iter().map(|st| w * (h + st.r[k]).signum()).sum();
+        (self.children_penalty(s, k, h), slope)
+    }
+
     /// The heading step: each `h_k` on the IMU's own window cost plus the
-    /// children's heading penalties (their relative headings held).
-    fn heading_step(&self, s: &mut State, stride: usize, scan: bool, scan_step: f64) {
+    /// children's heading penalties (their relative headings held). Returns
+    /// the own window costs `e_k(C, h_k)` at the new headings.
+    fn heading_step(
+        &self,
+        s: &mut State,
+        stride: usize,
+        scan: bool,
+        opts: &HeadingOptions,
+    ) -> Vec<f64> {
         let (c, h) = (&s.c, &s.h);
         let state: &State = s;
-        let steps: Vec<(f64, usize, usize)> = (0..h.len())
+        let steps: Vec<(f64, usize, usize, f64)> = (0..h.len())
             .into_par_iter()
             .map(|k| {
                 let cost = self.own.heading_cost(&self.own.windows[k], c, stride);
-                let f = |x: f64| cost.eval(x) + self.children_penalty(state, k, x);
-                let (hk, e) = line_search(&f, &neighbour_starts(h, k), scan, scan_step);
-                (hk, e, e * cost.len())
+                let value = |x: f64| cost.eval(x) + self.children_penalty(state, k, x);
+                let slope = |x: f64| {
+                    let (f, d) = cost.eval_slope(x);
+                    let (p, dp) = self.children_penalty_slope(state, k, x);
+                    (f + p, d + dp)
+                };
+                let scan = (scan, opts.scan_step_deg);
+                let starts = neighbour_starts(h, k);
+                let (hk, e) = heading_search(&value, &slope, &starts, scan, opts.solver);
+                (hk, e, e * cost.len(), cost.eval(hk))
             })
             .collect();
-        for (k, (hk, e, work)) in steps.into_iter().enumerate() {
+        let mut own = Vec::with_capacity(steps.len());
+        for (k, (hk, e, work, cost)) in steps.into_iter().enumerate() {
             s.h[k] = hk;
             s.window_evaluations[k] += e;
             s.sample_evaluations += work;
+            own.push(cost);
         }
+        own
     }
 
     /// Child j's constant correction on all windows: `Rm_i = (X_i C)^T R_up(-r_jk) Y_i`.
-    fn child_c_step(&self, s: &mut State, j: usize, fixed: &[Quat], stride: usize) {
+    fn child_c_step(
+        &self,
+        s: &mut State,
+        j: usize,
+        fixed: &[Quat],
+        stride: usize,
+        opts: &HeadingOptions,
+    ) {
         let cj = &self.children[j];
         let costs: Vec<WindowCost> = self
             .own
@@ -250,43 +284,57 @@ impl Lookahead<'_> {
                 WindowCost::new(&measured, cj.limits, self.own.lambda1)
             })
             .collect();
-        let total = |q: &Quat| costs.iter().map(|k| k.eval(q)).sum::<f64>();
-        let m = minimise(
-            &total,
-            &[s.children[j].c],
-            &c_step_options(s.rounds, stride),
-        );
+        let step = CStep {
+            own: &costs,
+            children: &[],
+            child_weight: 0.0,
+        };
+        let m = step.solve(&s.children[j].c, s.rounds, stride, opts.solver);
         s.c_evaluations += m.evaluations;
-        s.sample_evaluations += m.evaluations * costs.iter().map(WindowCost::len).sum::<usize>();
+        s.sample_evaluations += m.evaluations * step.samples();
         s.children[j].c = m.c;
     }
 
-    /// Child j's heading relative to the IMU's, per window.
+    /// Child j's heading relative to the IMU's, per window. Returns its
+    /// terms of J per window at the new headings (its window cost plus
+    /// `lambda1 |h_k + r_jk|`).
     fn child_heading_step(
         &self,
         s: &mut State,
         j: usize,
         fixed: &[Quat],
-        stride: usize,
-        scan: bool,
-        scan_step: f64,
-    ) {
+        (stride, scan): (usize, bool),
+        opts: &HeadingOptions,
+    ) -> Vec<f64> {
         let st = &s.children[j];
         let h = &s.h;
-        let steps: Vec<(f64, usize, usize)> = (0..h.len())
+        let steps: Vec<(f64, usize, usize, f64)> = (0..h.len())
             .into_par_iter()
             .map(|k| {
                 let cost = self.child_cost(j, st, fixed, k, stride);
-                let f = |x: f64| cost.eval(x) + self.own.lambda1 * (h[k] + x).abs();
-                let (rk, e) = line_search(&f, &neighbour_starts(&st.r, k), scan, scan_step);
-                (rk, e, e * cost.len())
+                let lambda1 = self.own.lambda1;
+                let value = |x: f64| cost.eval(x) + lambda1 * (h[k] + x).abs();
+                let slope = |x: f64| {
+                    let (f, d) = cost.eval_slope(x);
+                    (
+                        f + lambda1 * (h[k] + x).abs(),
+                        d + lambda1 * (h[k] + x).signum(),
+                    )
+                };
+                let scan = (scan, opts.scan_step_deg);
+                let starts = neighbour_starts(&st.r, k);
+                let (rk, e) = heading_search(&value, &slope, &starts, scan, opts.solver);
+                (rk, e, e * cost.len(), value(rk))
             })
             .collect();
-        for (k, (rk, e, work)) in steps.into_iter().enumerate() {
+        let mut terms = Vec::with_capacity(steps.len());
+        for (k, (rk, e, work, term)) in steps.into_iter().enumerate() {
             s.children[j].r[k] = rk;
             s.sample_evaluations += work;
             s.window_evaluations[k] += e;
+            terms.push(term);
         }
+        terms
     }
 
     /// Child joint j's window k as a function of its relative heading, with the
@@ -315,23 +363,6 @@ impl Lookahead<'_> {
             c_penalty: self.own.lambda1 * angle_deg(&st.c),
         }
     }
-
-    /// J on every `stride`-th sample.
-    fn total_at(&self, s: &State, stride: usize) -> f64 {
-        let own = self.own.total_at(&s.c, &s.h, stride);
-        let fixed = self.fixed_parent(&s.c);
-        let children: Vec<f64> = (0..self.children.len())
-            .flat_map(|j| (0..s.h.len()).map(move |k| (j, k)))
-            .collect::<Vec<_>>()
-            .par_iter()
-            .map(|&(j, k)| {
-                let st = &s.children[j];
-                self.child_cost(j, st, &fixed, k, stride).eval(st.r[k])
-                    + self.own.lambda1 * (s.h[k] + st.r[k]).abs()
-            })
-            .collect();
-        own + CHILD_WEIGHT * children.iter().sum::<f64>()
-    }
 }
 
 /// A child joint's window cost over its relative heading (no heading penalty).
@@ -343,6 +374,12 @@ struct ChildWindow {
 impl ChildWindow {
     fn eval(&self, r: f64) -> f64 {
         self.cost.eval(r) + self.c_penalty
+    }
+
+    /// [`ChildWindow::eval`] and its derivative in `r` (per degree).
+    fn eval_slope(&self, r: f64) -> (f64, f64) {
+        let (f, d) = self.cost.eval_slope(r);
+        (f + self.c_penalty, d)
     }
 
     fn len(&self) -> usize {

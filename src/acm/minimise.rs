@@ -15,7 +15,8 @@
 //!   is zero (the tip is then a minimum).
 //! - [`minimise`] ([`Solver::NelderMead`]) uses values only: Nelder-Mead, the
 //!   previous solver, kept selectable and as the oracle the gradient solver
-//!   is tested against; the heading variants' C steps still use it.
+//!   is tested against (the heading variants' C steps use either, as
+//!   [`super::heading::HeadingOptions::solver`] says).
 
 use crate::rotation::{angle_deg, quat_from_rotvec, Quat};
 use nalgebra::{Matrix3, Vector3};
