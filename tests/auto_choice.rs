@@ -212,26 +212,29 @@ fn check_choices(auto: &Correction) {
     }
 }
 
-/// Prints auto's choice per joint with the figures and the truth error of
-/// each single variant's own run (for tuning).
+/// Prints auto's choice per joint with the figures, the truth error of each
+/// single variant's own run and, last, `auto`'s own error at the joint (for
+/// tuning).
 fn trace(seed: u64, sim: &Simulated, auto: &Correction) {
     let runs: Vec<Vec<f64>> = SINGLES
         .iter()
         .map(|&v| joint_errors(sim, &run(&sim.trial, v)))
         .collect();
+    let own_errors = joint_errors(sim, auto);
     let model = Model::infant13();
     for (j, joint) in model.joints.iter().enumerate() {
         let Some(r) = auto.joint(&joint.name) else {
             continue;
         };
         let choice = r.auto.as_ref().unwrap();
+        let own = own_errors[j];
         for f in &choice.candidates {
             let truth = SINGLES
                 .iter()
                 .position(|&v| v == f.variant)
                 .map_or(f64::NAN, |k| runs[k][j]);
             eprintln!(
-                "TRACE,{seed},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
+                "TRACE,{seed},{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
                 joint.name,
                 f.variant,
                 f.excursion_deg,
@@ -240,7 +243,8 @@ fn trace(seed: u64, sim: &Simulated, auto: &Correction) {
                 f.heading_trend_deg.unwrap_or(f64::NAN),
                 f.centroid_pull.unwrap_or(f64::NAN),
                 f.score,
-                truth
+                truth,
+                own
             );
         }
     }
