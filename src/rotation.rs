@@ -45,6 +45,16 @@ pub fn euler_zyx_deg(q: &Quat) -> [f64; 3] {
     ]
 }
 
+/// The other Z-Y-X triplet of the same rotation (docs/method.md section 2.5):
+/// `[x + 180, 180 - y, z + 180]` for `y >= 0` and `[x + 180, -180 - y, z + 180]`
+/// for `y < 0`, x and z wrapped into `(-180, 180]`; degrees. Its middle
+/// angle lies beyond +-90 (on +-90 both triplets give the same rotation too).
+pub fn other_zyx_deg([x, y, z]: [f64; 3]) -> [f64; 3] {
+    let half_turn = |a: f64| if a > 0.0 { a - 180.0 } else { a + 180.0 };
+    let y2 = if y >= 0.0 { 180.0 - y } else { -180.0 - y };
+    [half_turn(x), y2, half_turn(z)]
+}
+
 /// The rotation `Rz(z) * Ry(y) * Rx(x)` for Z-Y-X Euler angles in degrees.
 pub fn quat_from_euler_zyx_deg(angles: [f64; 3]) -> Quat {
     let [x, y, z] = angles;
