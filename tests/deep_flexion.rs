@@ -117,3 +117,36 @@ fn crawling_knees_stay_within_the_noise_of_the_truth() {
         }
     }
 }
+
+/// The crawl's hips sit far above the table's hip centroid (12 deg of
+/// flexion): preparing the trial for a correction (what `acmw correct` and
+/// `acmw report` do) warns, naming both hips and `acmw centroids`; the
+/// knees (no centroid term) and the other joints are not named.
+#[test]
+fn preparing_a_crawl_warns_that_the_hips_sit_far_from_their_centroid() {
+    use acm_workbench::correct::pipeline::{prepare, Preparation, Setup};
+    let model = Model::infant13();
+    let limits = LimitTable::default_table();
+    let settings = Settings::default();
+    let sim = simulate_with(&preset("full_body_crawl").unwrap(), &model).unwrap();
+    let setup = Setup {
+        model: &model,
+        limits: &limits,
+        limits_source: "test",
+        settings: &settings,
+    };
+    let p = prepare(sim.trial.clone(), setup, &Preparation::default()).unwrap();
+    let named: Vec<&str> = p
+        .trial
+        .warnings
+        .iter()
+        .filter(|w| w.contains("centroid"))
+        .map(|w| w.split(':').next().unwrap())
+        .collect();
+    assert_eq!(named, ["l_hip", "r_hip"], "{:#?}", p.trial.warnings);
+    assert!(p
+        .trial
+        .warnings
+        .iter()
+        .any(|w| w.contains("acmw centroids")));
+}
