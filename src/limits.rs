@@ -78,43 +78,6 @@ pub struct JointLimits {
     pub axes: Option<crate::model::TableAxes>,
 }
 
-/// Whether a box's Y range (degrees) reaches beyond +-90: only then can the
-/// other Z-Y-X triplet of a rotation ([`crate::rotation::other_zyx_deg`],
-/// middle angle beyond +-90) be read in it (hip and knee flexion in Table 3-2).
-pub fn y_beyond_90(range_deg: &[[f64; 2]; 3]) -> bool {
-    range_deg[1][0] < -90.0 || range_deg[1][1] > 90.0
-}
-
-/// The Z-Y-X triplet (degrees) the limit box `range_deg` reads of a rotation
-/// whose principal triplet (middle angle in [-90, 90]) is `principal`
-/// (docs/method.md section 2.5): the principal one, unless the box's Y range
-/// reaches beyond +-90 and the other triplet has less total excursion beyond
-/// the limits (ties: the principal one).
-/// Either triplet may be given: one whose middle angle lies beyond +-90 is
-/// taken back to the principal one first.
-pub fn read_in_box(angles: [f64; 3], range_deg: &[[f64; 2]; 3]) -> [f64; 3] {
-    let principal = if angles[1].abs() > 90.0 {
-        crate::rotation::other_zyx_deg(angles)
-    } else {
-        angles
-    };
-    if !y_beyond_90(range_deg) {
-        return principal;
-    }
-    let e = crate::acm::cost::excursion(principal, range_deg);
-    let total = e[0] + e[1] + e[2];
-    if total == 0.0 {
-        return principal;
-    }
-    let other = crate::rotation::other_zyx_deg(principal);
-    let e2 = crate::acm::cost::excursion(other, range_deg);
-    if e2[0] + e2[1] + e2[2] < total {
-        other
-    } else {
-        principal
-    }
-}
-
 impl JointLimits {
     /// The same limits as the engine's costs apply them to a joint rotation
     /// `R` of `joint`'s segment frames (docs/method.md section 2.5): on the
@@ -836,6 +799,27 @@ impl Solver {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The boxes `Joint::limit_box` reads (`builtin_box`, parsed apart from
+    /// this module) are the default table's, for every joint of every
+    /// built-in model.
+    #[test]
+    fn builtin_boxes_equal_the_default_table() {
+        let table = LimitTable::default_table();
+        let mut checked = 0;
+        for (name, _) in crate::model::BUILTIN_MODELS {
+            let model = crate::model::Model::builtin(name).unwrap();
+            for j in &model.joints {
+                let want = table
+                    .joint_limits(&j.name, &j.kind, false)
+                    .map(|l| l.range_deg);
+                assert_eq!(j.limit_box(), want, "{name} {}", j.name);
+                checked += usize::from(want.is_some());
+            }
+        }
+        assert!(checked > 30, "{checked}");
+        assert_eq!(crate::builtin_box::table_3_2_box("nowhere", "none"), None);
+    }
 
     #[test]
     fn shipped_tables_match_method_section_5() {

@@ -27,7 +27,7 @@ pub fn joint_angles(trial: &Trial, joint: &Joint) -> Option<Vec<[f64; 3]>> {
                     None => crate::rotation::euler_zyx_deg(&r),
                 };
                 match &limit_box {
-                    Some(b) => crate::limits::read_in_box(principal, b),
+                    Some(b) => crate::rotation::read_in_box(principal, b),
                     None => principal,
                 }
             })
@@ -55,7 +55,7 @@ pub struct ExcursionFigures {
 pub const ON_LIMIT_DEG: f64 = 1e-9;
 
 /// Excursion figures of joint angles against limits. Each sample's angles
-/// are read in the limits' box first ([`crate::limits::read_in_box`]: of its
+/// are read in the limits' box first ([`crate::rotation::read_in_box`]: of its
 /// two Z-Y-X triplets, the one the box reads), so the figures count what the
 /// ACM's cost counts whichever table the angles were shown in.
 pub fn excursion_figures(angles: &[[f64; 3]], limits: &JointLimits) -> ExcursionFigures {
@@ -65,7 +65,7 @@ pub fn excursion_figures(angles: &[[f64; 3]], limits: &JointLimits) -> Excursion
     let mut sum = [0.0; 3];
     for a in angles {
         let e = excursion(
-            crate::limits::read_in_box(*a, &limits.range_deg),
+            crate::rotation::read_in_box(*a, &limits.range_deg),
             &limits.range_deg,
         );
         for k in 0..3 {

@@ -418,7 +418,7 @@ impl Joint {
     /// identity `angle_axes`, the Z-Y-X angles of `r` itself.
     ///
     /// Of the rotation's two Z-Y-X triplets it is the one the joint's limit
-    /// box reads ([`crate::limits::read_in_box`], docs/method.md section 2.5):
+    /// box reads ([`crate::rotation::read_in_box`], docs/method.md section 2.5):
     /// where the box's Y range reaches beyond +-90 (hip and knee flexion), a
     /// knee flexed 120 deg reads 120 on Y. The box is the built-in table's
     /// (Table 3-2) row of the joint ([`Joint::limit_box`]); figures against
@@ -426,7 +426,7 @@ impl Joint {
     pub fn table_angles(&self, r: &crate::rotation::Quat) -> [f64; 3] {
         let principal = self.principal_table_angles(r);
         match self.limit_box() {
-            Some(b) => crate::limits::read_in_box(principal, &b),
+            Some(b) => crate::rotation::read_in_box(principal, &b),
             None => principal,
         }
     }
@@ -445,11 +445,7 @@ impl Joint {
     /// angles are read in: its row (by name, else kind) of the built-in table
     /// (Table 3-2), `None` when that table has no row for it.
     pub fn limit_box(&self) -> Option<[[f64; 2]; 3]> {
-        static TABLE: std::sync::OnceLock<crate::limits::LimitTable> = std::sync::OnceLock::new();
-        TABLE
-            .get_or_init(crate::limits::LimitTable::default_table)
-            .joint_limits(&self.name, &self.kind, false)
-            .map(|l| l.range_deg)
+        crate::builtin_box::table_3_2_box(&self.name, &self.kind)
     }
 
     /// The two axes a two-degree-of-freedom joint (the elbow) turns about, in
@@ -1147,7 +1143,7 @@ distal = "b"
                 let shown = j.table_angles(&j.rotation(t));
                 let want = j
                     .limit_box()
-                    .map_or(t, |b| crate::limits::read_in_box(t, &b));
+                    .map_or(t, |b| crate::rotation::read_in_box(t, &b));
                 for k in 0..3 {
                     let d = crate::rotation::wrap180(shown[k] - want[k]);
                     assert!(d.abs() < 1e-9, "{} {t:?} -> {shown:?}", j.name);
@@ -1205,7 +1201,7 @@ distal = "b"
                 assert_eq!(j.principal_table_angles(&r), zyx);
                 let want = j
                     .limit_box()
-                    .map_or(zyx, |b| crate::limits::read_in_box(zyx, &b));
+                    .map_or(zyx, |b| crate::rotation::read_in_box(zyx, &b));
                 assert_eq!(j.angles(&p, &d), want);
                 assert_eq!(j.rotation(t), crate::rotation::quat_from_euler_zyx_deg(t));
             }

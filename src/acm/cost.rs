@@ -63,7 +63,7 @@ pub fn cost_direct(measured: &[Quat], c: &Quat, limits: &JointLimits, lambda1: f
         .iter()
         .map(|qm| {
             let qt = limits.to_axes(&(qm * c));
-            let angles = crate::limits::read_in_box(euler_zyx_deg(&qt), &limits.range_deg);
+            let angles = crate::rotation::read_in_box(euler_zyx_deg(&qt), &limits.range_deg);
             let e: f64 = excursion(angles, &limits.range_deg).iter().sum();
             match centroid {
                 Some(qc) if limits.lambda2 > 0.0 => e + limits.lambda2 * rmsq(&qt, &qc),
@@ -282,7 +282,7 @@ pub(super) struct LimitTerms {
     pub(super) centroid: Option<Quat>,
     lambda2: f64,
     /// The other Z-Y-X triplet's middle-angle test, when the Y range
-    /// reaches beyond +-90 ([`crate::limits::read_in_box`]): a sample's
+    /// reaches beyond +-90 ([`crate::rotation::read_in_box`]): a sample's
     /// excursion is then the smaller of its two triplets'.
     other: Option<OtherPitch>,
 }
@@ -298,7 +298,7 @@ impl LimitTerms {
                 _ => None,
             },
             lambda2: limits.lambda2,
-            other: crate::limits::y_beyond_90(&limits.range_deg)
+            other: crate::rotation::y_beyond_90(&limits.range_deg)
                 .then(|| OtherPitch::new(limits.range_deg[1])),
         }
     }

@@ -175,7 +175,7 @@ fn solve_rivest(
                 None => euler_zyx_deg(q),
             };
             match &limit_box {
-                Some(b) => crate::limits::read_in_box(principal, b),
+                Some(b) => crate::rotation::read_in_box(principal, b),
                 None => principal,
             }
         })

@@ -151,7 +151,7 @@ impl<'a> Solver<'a> {
             let in_table = s.frame.inverse() * rel * s.frame;
             let table = euler_zyx_deg(&in_table).map(|a| s.det * a);
             let e = match &s.limit_box {
-                Some(b) => crate::limits::read_in_box(table, b),
+                Some(b) => crate::rotation::read_in_box(table, b),
                 None => table,
             }
             .map(f64::to_radians);
