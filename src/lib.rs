@@ -11,6 +11,7 @@ pub mod acm;
 pub mod analysis;
 pub mod baselines;
 pub mod batch;
+pub mod builtin_box;
 pub mod calibration;
 pub mod correct;
 pub mod file_names;

@@ -800,6 +800,27 @@ impl Solver {
 mod tests {
     use super::*;
 
+    /// The boxes `Joint::limit_box` reads (`builtin_box`, parsed apart from
+    /// this module) are the default table's, for every joint of every
+    /// built-in model.
+    #[test]
+    fn builtin_boxes_equal_the_default_table() {
+        let table = LimitTable::default_table();
+        let mut checked = 0;
+        for (name, _) in crate::model::BUILTIN_MODELS {
+            let model = crate::model::Model::builtin(name).unwrap();
+            for j in &model.joints {
+                let want = table
+                    .joint_limits(&j.name, &j.kind, false)
+                    .map(|l| l.range_deg);
+                assert_eq!(j.limit_box(), want, "{name} {}", j.name);
+                checked += usize::from(want.is_some());
+            }
+        }
+        assert!(checked > 30, "{checked}");
+        assert_eq!(crate::builtin_box::table_3_2_box("nowhere", "none"), None);
+    }
+
     #[test]
     fn shipped_tables_match_method_section_5() {
         let t = LimitTable::default_table();

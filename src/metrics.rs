@@ -15,7 +15,24 @@ use serde::{Deserialize, Serialize};
 pub fn joint_angles(trial: &Trial, joint: &Joint) -> Option<Vec<[f64; 3]>> {
     let p = &trial.imu(&joint.proximal)?.orientation;
     let d = &trial.imu(&joint.distal)?.orientation;
-    Some(p.iter().zip(d).map(|(p, d)| joint.angles(p, d)).collect())
+    let axes = joint.table_axes();
+    let limit_box = joint.limit_box();
+    Some(
+        p.iter()
+            .zip(d)
+            .map(|(p, d)| {
+                let r = p.inverse() * d;
+                let principal = match &axes {
+                    Some(t) => t.angles(&r),
+                    None => crate::rotation::euler_zyx_deg(&r),
+                };
+                match &limit_box {
+                    Some(b) => crate::rotation::read_in_box(principal, b),
+                    None => principal,
+                }
+            })
+            .collect(),
+    )
 }
 
 /// Excursion figures of one joint (Tables 4-1, 4-2 and Figure 4-20).
@@ -37,14 +54,20 @@ pub struct ExcursionFigures {
 /// hard limits, which may be a table's limits) across it.
 pub const ON_LIMIT_DEG: f64 = 1e-9;
 
-/// Excursion figures of joint angles against limits.
+/// Excursion figures of joint angles against limits. Each sample's angles
+/// are read in the limits' box first ([`crate::rotation::read_in_box`]: of its
+/// two Z-Y-X triplets, the one the box reads), so the figures count what the
+/// ACM's cost counts whichever table the angles were shown in.
 pub fn excursion_figures(angles: &[[f64; 3]], limits: &JointLimits) -> ExcursionFigures {
     let n = angles.len().max(1) as f64;
     let mut out_count = [0usize; 3];
     let mut any = 0usize;
     let mut sum = [0.0; 3];
     for a in angles {
-        let e = excursion(*a, &limits.range_deg);
+        let e = excursion(
+            crate::rotation::read_in_box(*a, &limits.range_deg),
+            &limits.range_deg,
+        );
         for k in 0..3 {
             sum[k] += e[k];
             out_count[k] += usize::from(e[k] > ON_LIMIT_DEG);

@@ -416,11 +416,36 @@ impl Joint {
     /// rotation `r` (distal segment frame in the proximal one): the Z-Y-X
     /// angles of `r` expressed in the table's axes (see [`TableAxes`]). With
     /// identity `angle_axes`, the Z-Y-X angles of `r` itself.
+    ///
+    /// Of the rotation's two Z-Y-X triplets it is the one the joint's limit
+    /// box reads ([`crate::rotation::read_in_box`], docs/method.md section 2.5):
+    /// where the box's Y range reaches beyond +-90 (hip and knee flexion), a
+    /// knee flexed 120 deg reads 120 on Y. The box is the built-in table's
+    /// (Table 3-2) row of the joint ([`Joint::limit_box`]); figures against
+    /// another table read the angles in its box again.
     pub fn table_angles(&self, r: &crate::rotation::Quat) -> [f64; 3] {
+        let principal = self.principal_table_angles(r);
+        match self.limit_box() {
+            Some(b) => crate::rotation::read_in_box(principal, &b),
+            None => principal,
+        }
+    }
+
+    /// The principal Z-Y-X triplet (middle angle in [-90, 90]) of the joint
+    /// rotation `r` in the table's axes, degrees: [`Joint::table_angles`]
+    /// before the limit box picks a triplet.
+    pub fn principal_table_angles(&self, r: &crate::rotation::Quat) -> [f64; 3] {
         match self.table_axes() {
             Some(t) => t.angles(r),
             None => crate::rotation::euler_zyx_deg(r),
         }
+    }
+
+    /// The limit box `[[lo, hi]; 3]` (degrees, table convention) the joint's
+    /// angles are read in: its row (by name, else kind) of the built-in table
+    /// (Table 3-2), `None` when that table has no row for it.
+    pub fn limit_box(&self) -> Option<[[f64; 2]; 3]> {
+        crate::builtin_box::table_3_2_box(&self.name, &self.kind)
     }
 
     /// The two axes a two-degree-of-freedom joint (the elbow) turns about, in
@@ -1106,13 +1131,22 @@ distal = "b"
                     rng.random_range(-89.0..89.0),
                     rng.random_range(-179.9..179.9),
                 ];
-                let back = j.table_angles(&j.rotation(t));
+                let back = j.principal_table_angles(&j.rotation(t));
                 for k in 0..3 {
                     assert!(
                         (back[k] - t[k]).abs() < 1e-9,
                         "{} {t:?} -> {back:?}",
                         j.name
                     );
+                }
+                // The triplet shown is the one the joint's limit box reads.
+                let shown = j.table_angles(&j.rotation(t));
+                let want = j
+                    .limit_box()
+                    .map_or(t, |b| crate::rotation::read_in_box(t, &b));
+                for k in 0..3 {
+                    let d = crate::rotation::wrap180(shown[k] - want[k]);
+                    assert!(d.abs() < 1e-9, "{} {t:?} -> {shown:?}", j.name);
                 }
             }
         }
@@ -1163,10 +1197,57 @@ distal = "b"
                 let p = crate::rotation::quat_from_euler_zyx_deg(t.map(|a| 0.5 * a));
                 let d = crate::rotation::quat_from_euler_zyx_deg(t);
                 let r = p.inverse() * d;
-                assert_eq!(j.angles(&p, &d), crate::rotation::euler_zyx_deg(&r));
+                let zyx = crate::rotation::euler_zyx_deg(&r);
+                assert_eq!(j.principal_table_angles(&r), zyx);
+                let want = j
+                    .limit_box()
+                    .map_or(zyx, |b| crate::rotation::read_in_box(zyx, &b));
+                assert_eq!(j.angles(&p, &d), want);
                 assert_eq!(j.rotation(t), crate::rotation::quat_from_euler_zyx_deg(t));
             }
         }
+    }
+
+    /// Hip and knee flexion beyond 90 deg (Table 3-2: hip Y -30..100, knee
+    /// Y 0..130) read as flexion on the table's Y in every built-in model: a
+    /// turn by `y` about the segment axis `angle_axes[1]` names (the sense
+    /// the table counts positive) reads `[0, y, 0]`, where the principal
+    /// Z-Y-X triplet would read `[180, 180 - y, 180]`.
+    #[test]
+    fn hip_and_knee_flexion_beyond_90_read_on_y_in_every_model() {
+        let mut checked = 0;
+        for (name, _) in BUILTIN_MODELS {
+            let m = Model::builtin(name).unwrap();
+            for j in m
+                .joints
+                .iter()
+                .filter(|j| j.kind == "hip" || j.kind == "knee")
+            {
+                let flexions: &[f64] = if j.kind == "knee" {
+                    &[100.0, 120.0, 140.0]
+                } else {
+                    &[95.0]
+                };
+                let axis = j.angle_axes[1].vector();
+                for &flex in flexions {
+                    let r = crate::rotation::quat_axis_angle_deg(axis, flex);
+                    let a = j.table_angles(&r);
+                    assert!(
+                        a[0].abs() < 1e-9 && (a[1] - flex).abs() < 1e-9 && a[2].abs() < 1e-9,
+                        "{name} {} {flex}: {a:?}",
+                        j.name
+                    );
+                    let p = j.principal_table_angles(&r);
+                    assert!((p[1] - (180.0 - flex)).abs() < 1e-9, "{p:?}");
+                    // The segments' angles go through the same reading.
+                    let prox = crate::rotation::quat_axis_angle_deg([0.3, -1.0, 0.2], 37.0);
+                    let b = j.angles(&prox, &(prox * r));
+                    assert!((b[1] - flex).abs() < 1e-9, "{b:?}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked >= 4 * 8, "{checked}");
     }
 
     #[test]

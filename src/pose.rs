@@ -307,6 +307,7 @@ pub fn calibrate(
     ))
 }
 
+pub mod centroid_check;
 pub mod convention;
 
 #[cfg(test)]

@@ -45,6 +45,67 @@ pub fn euler_zyx_deg(q: &Quat) -> [f64; 3] {
     ]
 }
 
+/// The other Z-Y-X triplet of the same rotation (docs/method.md section 2.5):
+/// `[x + 180, 180 - y, z + 180]` for `y >= 0` and `[x + 180, -180 - y, z + 180]`
+/// for `y < 0`, x and z wrapped into `(-180, 180]`; degrees. Its middle
+/// angle lies beyond +-90 (on +-90 both triplets give the same rotation too).
+pub fn other_zyx_deg([x, y, z]: [f64; 3]) -> [f64; 3] {
+    let half_turn = |a: f64| if a > 0.0 { a - 180.0 } else { a + 180.0 };
+    let y2 = if y >= 0.0 { 180.0 - y } else { -180.0 - y };
+    [half_turn(x), y2, half_turn(z)]
+}
+
+/// `Ex + Ey + Ez`: the summed excursion (degrees) of angles beyond a box, as
+/// `acm::cost::excursion` counts it per axis (`a - hi` above, `lo - a` below).
+fn total_excursion(angles: [f64; 3], range_deg: &[[f64; 2]; 3]) -> f64 {
+    let mut sum = 0.0;
+    for (a, [lo, hi]) in angles.into_iter().zip(range_deg) {
+        sum += if a > *hi {
+            a - hi
+        } else if a < *lo {
+            lo - a
+        } else {
+            0.0
+        };
+    }
+    sum
+}
+
+/// Whether a box's Y range (degrees) reaches beyond +-90: only then can the
+/// other Z-Y-X triplet of a rotation ([`other_zyx_deg`],
+/// middle angle beyond +-90) be read in it (hip and knee flexion in Table 3-2).
+pub fn y_beyond_90(range_deg: &[[f64; 2]; 3]) -> bool {
+    range_deg[1][0] < -90.0 || range_deg[1][1] > 90.0
+}
+
+/// The Z-Y-X triplet (degrees) the limit box `range_deg` reads of a rotation
+/// whose principal triplet (middle angle in [-90, 90]) is `principal`
+/// (docs/method.md section 2.5): the principal one, unless the box's Y range
+/// reaches beyond +-90 and the other triplet has less total excursion beyond
+/// the limits (ties: the principal one).
+/// Either triplet may be given: one whose middle angle lies beyond +-90 is
+/// taken back to the principal one first.
+pub fn read_in_box(angles: [f64; 3], range_deg: &[[f64; 2]; 3]) -> [f64; 3] {
+    let principal = if angles[1].abs() > 90.0 {
+        other_zyx_deg(angles)
+    } else {
+        angles
+    };
+    if !y_beyond_90(range_deg) {
+        return principal;
+    }
+    let total = total_excursion(principal, range_deg);
+    if total == 0.0 {
+        return principal;
+    }
+    let other = other_zyx_deg(principal);
+    if total_excursion(other, range_deg) < total {
+        other
+    } else {
+        principal
+    }
+}
+
 /// The rotation `Rz(z) * Ry(y) * Rx(x)` for Z-Y-X Euler angles in degrees.
 pub fn quat_from_euler_zyx_deg(angles: [f64; 3]) -> Quat {
     let [x, y, z] = angles;

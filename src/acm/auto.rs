@@ -241,7 +241,8 @@ fn decide(figures: &[CandidateFigures], angles: &[Vec<[f64; 3]>]) -> Choice {
 fn joint_mean_excursion_deg(angles: &[[f64; 3]], range_deg: &[[f64; 2]; 3]) -> f64 {
     let mut sum = [0.0; 3];
     for a in angles {
-        for (s, e) in sum.iter_mut().zip(excursion(*a, range_deg)) {
+        let a = crate::rotation::read_in_box(*a, range_deg);
+        for (s, e) in sum.iter_mut().zip(excursion(a, range_deg)) {
             *s += e;
         }
     }

@@ -63,9 +63,8 @@ pub fn cost_direct(measured: &[Quat], c: &Quat, limits: &JointLimits, lambda1: f
         .iter()
         .map(|qm| {
             let qt = limits.to_axes(&(qm * c));
-            let e: f64 = excursion(euler_zyx_deg(&qt), &limits.range_deg)
-                .iter()
-                .sum();
+            let angles = crate::rotation::read_in_box(euler_zyx_deg(&qt), &limits.range_deg);
+            let e: f64 = excursion(angles, &limits.range_deg).iter().sum();
             match centroid {
                 Some(qc) if limits.lambda2 > 0.0 => e + limits.lambda2 * rmsq(&qt, &qc),
                 _ => e,
@@ -131,6 +130,20 @@ impl ArcRange {
         beyond_slope(s.atan2(c).to_degrees(), self.lo, self.hi)
     }
 
+    /// As [`ArcRange::excursion_slope`] for the other Z-Y-X triplet's angle,
+    /// `atan2(-s, -c)` (the angle plus 180, in `(-180, 180]`).
+    #[inline(always)]
+    fn other_excursion_slope(&self, s: f64, c: f64) -> (f64, f64) {
+        if self.inside(-s, -c) {
+            return (0.0, 0.0);
+        }
+        let mut a = (-s).atan2(-c).to_degrees();
+        if a <= -180.0 {
+            a = 180.0;
+        }
+        beyond_slope(a, self.lo, self.hi)
+    }
+
     #[inline(always)]
     fn inside(&self, s: f64, c: f64) -> bool {
         if self.full {
@@ -190,6 +203,11 @@ impl PitchRange {
         beyond(-r20.clamp(-1.0, 1.0).asin().to_degrees(), self.lo, self.hi)
     }
 
+    #[inline(always)]
+    fn inside(&self, r20: f64) -> bool {
+        r20 <= self.r20_max && r20 >= self.r20_min
+    }
+
     /// As [`PitchRange::excursion`], with the slope in theta.
     #[inline(always)]
     fn excursion_slope(&self, r20: f64) -> (f64, f64) {
@@ -197,6 +215,59 @@ impl PitchRange {
             return (0.0, 0.0);
         }
         beyond_slope(-r20.clamp(-1.0, 1.0).asin().to_degrees(), self.lo, self.hi)
+    }
+}
+
+/// Test of the other Z-Y-X triplet's middle angle against a range that
+/// reaches beyond +-90 (docs/method.md section 2.5): with `theta =
+/// -asin(r20)`, the other triplet's is `theta' = 180 - theta` for `theta >= 0`
+/// (`r20 <= 0`) and `-180 - theta` below, so `theta'` lies in `[lo, hi]` when
+/// `theta` lies in `[180 - hi, 180 - lo]`, or in `[-180 - hi, -180 - lo]`:
+/// two tests on `r20` without trigonometry.
+#[derive(Debug, Clone, Copy)]
+struct OtherPitch {
+    lo: f64,
+    hi: f64,
+    /// `theta >= 0`: `theta'` in range.
+    up: PitchRange,
+    /// `theta < 0`: `theta'` in range.
+    down: PitchRange,
+}
+
+impl OtherPitch {
+    fn new([lo, hi]: [f64; 2]) -> Self {
+        OtherPitch {
+            lo,
+            hi,
+            up: PitchRange::new([180.0 - hi, 180.0 - lo]),
+            down: PitchRange::new([-180.0 - hi, -180.0 - lo]),
+        }
+    }
+
+    #[inline(always)]
+    fn inside(&self, r20: f64) -> bool {
+        if r20 <= 0.0 {
+            self.up.inside(r20)
+        } else {
+            self.down.inside(r20)
+        }
+    }
+
+    /// The other triplet's middle-angle excursion and its slope in `theta`
+    /// (the principal middle angle): `d theta' / d theta = -1`.
+    #[inline(always)]
+    fn excursion_slope(&self, r20: f64) -> (f64, f64) {
+        if self.inside(r20) {
+            return (0.0, 0.0);
+        }
+        let theta = -r20.clamp(-1.0, 1.0).asin().to_degrees();
+        let other = if theta >= 0.0 {
+            180.0 - theta
+        } else {
+            -180.0 - theta
+        };
+        let (e, s) = beyond_slope(other, self.lo, self.hi);
+        (e, -s)
     }
 }
 
@@ -210,6 +281,10 @@ pub(super) struct LimitTerms {
     /// The centroid's rotation, when the term is on (`lambda2 > 0`).
     pub(super) centroid: Option<Quat>,
     lambda2: f64,
+    /// The other Z-Y-X triplet's middle-angle test, when the Y range
+    /// reaches beyond +-90 ([`crate::rotation::read_in_box`]): a sample's
+    /// excursion is then the smaller of its two triplets'.
+    other: Option<OtherPitch>,
 }
 
 impl LimitTerms {
@@ -223,14 +298,65 @@ impl LimitTerms {
                 _ => None,
             },
             lambda2: limits.lambda2,
+            other: crate::rotation::y_beyond_90(&limits.range_deg)
+                .then(|| OtherPitch::new(limits.range_deg[1])),
         }
     }
 
     /// `Ex + Ey + Ez` (degrees) of the Z-Y-X angles of a rotation, from its
-    /// entries `[r00, r10, r20, r21, r22]`.
+    /// entries `[r00, r10, r20, r21, r22]`; where the Y range reaches beyond
+    /// +-90, of the triplet the limits read (the smaller total of the two;
+    /// no trigonometry when either triplet is inside).
     #[inline(always)]
     pub(super) fn excursion(&self, [r00, r10, r20, r21, r22]: [f64; 5]) -> f64 {
-        self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00)
+        let Some(other) = &self.other else {
+            return self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00);
+        };
+        if self.x.inside(r21, r22) && self.y.inside(r20) && self.z.inside(r10, r00) {
+            return 0.0;
+        }
+        if self.x.inside(-r21, -r22) && other.inside(r20) && self.z.inside(-r10, -r00) {
+            return 0.0;
+        }
+        let p = self.x.excursion(r21, r22) + self.y.excursion(r20) + self.z.excursion(r10, r00);
+        let q = self.x.other_excursion_slope(r21, r22).0
+            + other.excursion_slope(r20).0
+            + self.z.other_excursion_slope(r10, r00).0;
+        if q < p {
+            q
+        } else {
+            p
+        }
+    }
+
+    /// The excursions `(E, s)` of the three angles and their slopes in the
+    /// principal triplet's angles (`phi`, `theta`, `psi`): of the principal
+    /// triplet, or of the other one where the limits read it (its angles move
+    /// as `phi`, `-theta`, `psi`).
+    #[inline(always)]
+    fn slopes(&self, [r00, r10, r20, r21, r22]: [f64; 5]) -> [(f64, f64); 3] {
+        let principal = [
+            self.x.excursion_slope(r21, r22),
+            self.y.excursion_slope(r20),
+            self.z.excursion_slope(r10, r00),
+        ];
+        let Some(other) = &self.other else {
+            return principal;
+        };
+        let p = principal[0].0 + principal[1].0 + principal[2].0;
+        if p == 0.0 {
+            return principal;
+        }
+        let alt = [
+            self.x.other_excursion_slope(r21, r22),
+            other.excursion_slope(r20),
+            self.z.other_excursion_slope(r10, r00),
+        ];
+        if alt[0].0 + alt[1].0 + alt[2].0 < p {
+            alt
+        } else {
+            principal
+        }
     }
 
     /// As [`LimitTerms::excursion`] for a rotation `Rt`, adding to `g` the
@@ -245,9 +371,7 @@ impl LimitTerms {
         [r00, r10, r20, r21, r22]: [f64; 5],
         g: &mut [f64; 3],
     ) -> f64 {
-        let (ex, sx) = self.x.excursion_slope(r21, r22);
-        let (ey, sy) = self.y.excursion_slope(r20);
-        let (ez, sz) = self.z.excursion_slope(r10, r00);
+        let [(ex, sx), (ey, sy), (ez, sz)] = self.slopes([r00, r10, r20, r21, r22]);
         if sx != 0.0 {
             let rho = r21 * r21 + r22 * r22;
             if rho > 0.0 {
@@ -288,9 +412,7 @@ impl LimitTerms {
         [r00, r10, r20, r21, r22]: [f64; 5],
         [d00, d10, d20, d21, d22]: [f64; 5],
     ) -> (f64, f64) {
-        let (ex, sx) = self.x.excursion_slope(r21, r22);
-        let (ey, sy) = self.y.excursion_slope(r20);
-        let (ez, sz) = self.z.excursion_slope(r10, r00);
+        let [(ex, sx), (ey, sy), (ez, sz)] = self.slopes([r00, r10, r20, r21, r22]);
         let mut slope = 0.0;
         let rho = r21 * r21 + r22 * r22;
         if sx != 0.0 && rho > 0.0 {
@@ -675,10 +797,19 @@ mod tests {
     fn check_gradient_in(limits: JointLimits) {
         let mut rng = ChaCha8Rng::seed_from_u64(12);
         let measured: Vec<Quat> = (0..300).map(|_| random_quat(&mut rng, 120.0)).collect();
-        let cost = WindowCost::new(&measured, &limits, 0.05);
+        check_gradient_on(&measured, limits, &mut rng, 60.0);
+    }
+
+    fn check_gradient_on(
+        measured: &[Quat],
+        limits: JointLimits,
+        rng: &mut ChaCha8Rng,
+        max_correction_deg: f64,
+    ) {
+        let cost = WindowCost::new(measured, &limits, 0.05);
         let mut near_kink = 0;
         for _ in 0..30 {
-            let c = random_quat(&mut rng, 60.0);
+            let c = random_quat(rng, max_correction_deg);
             let (f, g) = cost.data_grad(&c);
             assert_eq!(f + 0.05 * angle_deg(&c), cost.eval(&c));
             // One-sided differences over 1e-7 rad; where they disagree a
@@ -732,6 +863,138 @@ mod tests {
             lambda2: 30.0,
             axes: None,
         });
+    }
+
+    /// Knee- and hip-like samples flexed 40-170 deg (with X and Z up to
+    /// +-12 deg) given in the table's axes: their principal Z-Y-X triplets
+    /// fold back beyond 90 deg of flexion.
+    fn deep_flexion(
+        rng: &mut ChaCha8Rng,
+        n: usize,
+        axes: Option<crate::model::TableAxes>,
+    ) -> Vec<Quat> {
+        use rand::Rng;
+        (0..n)
+            .map(|_| {
+                let t = [
+                    rng.random_range(-12.0..12.0),
+                    rng.random_range(40.0..170.0),
+                    rng.random_range(-12.0..12.0),
+                ];
+                match &axes {
+                    // The engine reads `Q^T R Q`, whose angles are the
+                    // table's times det(P).
+                    Some(a) => a.from_table(&quat_from_euler_zyx_deg(t.map(|v| a.det * v))),
+                    None => quat_from_euler_zyx_deg(t),
+                }
+            })
+            .collect()
+    }
+
+    /// Table limits as the engine holds them in `axes` (negated for a mirror
+    /// image, as `JointLimits::in_table_axes` gives them).
+    fn engine_limits(
+        range: [[f64; 2]; 3],
+        centroid: Option<[f64; 3]>,
+        axes: Option<crate::model::TableAxes>,
+    ) -> JointLimits {
+        let flip = axes.is_some_and(|a| a.det < 0.0);
+        JointLimits {
+            range_deg: range.map(|[lo, hi]| if flip { [-hi, -lo] } else { [lo, hi] }),
+            centroid_deg: centroid.map(|c| c.map(|v| if flip { -v } else { v })),
+            lambda2: if centroid.is_some() { 30.0 } else { 0.0 },
+            axes,
+        }
+    }
+
+    /// Where the Y range reaches beyond 90 (knee 0..130, hip -30..100) a
+    /// sample costs the excursion of the triplet with the smaller total
+    /// (docs/method.md section 2.5): the fast cost equals that formula, per
+    /// sample from both triplets, across the switch between them; and a knee
+    /// flexed 100-130 deg costs nothing at the identity (it did cost before:
+    /// the principal triplet reads X and Z half a turn away).
+    #[test]
+    fn cost_reads_the_triplet_the_limits_read_across_the_switch() {
+        use crate::rotation::other_zyx_deg;
+        let mut rng = ChaCha8Rng::seed_from_u64(14);
+        let knee = [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]];
+        let hip = [[-50.0, 40.0], [-30.0, 100.0], [-20.0, 50.0]];
+        for (range, centroid) in [(knee, None), (hip, Some([-5.0, 12.0, -5.0]))] {
+            for axes in test_axes() {
+                let limits = engine_limits(range, centroid, axes);
+                let measured = deep_flexion(&mut rng, 300, axes);
+                let cost = WindowCost::new(&measured, &limits, 0.05);
+                let centroid_q = limits.centroid_deg.map(quat_from_euler_zyx_deg);
+                let (mut principal_read, mut other_read) = (0, 0);
+                for _ in 0..40 {
+                    let c = random_quat(&mut rng, 25.0);
+                    let want: f64 = measured
+                        .iter()
+                        .map(|m| {
+                            let qt = limits.to_axes(&(m * c));
+                            let p = euler_zyx_deg(&qt);
+                            let total = |a: [f64; 3]| -> f64 {
+                                excursion(a, &limits.range_deg).iter().sum()
+                            };
+                            let (ep, eo) = (total(p), total(other_zyx_deg(p)));
+                            if ep > 0.0 && eo < ep {
+                                other_read += 1;
+                            } else if ep > 0.0 {
+                                principal_read += 1;
+                            }
+                            let e = ep.min(eo);
+                            e + centroid_q.map_or(0.0, |qc| limits.lambda2 * rmsq(&qt, &qc))
+                        })
+                        .sum::<f64>()
+                        / measured.len() as f64
+                        + 0.05 * angle_deg(&c);
+                    let fast = cost.eval(&c);
+                    assert!((fast - want).abs() < 1e-9, "{fast} vs {want}");
+                    let direct = cost_direct(&measured, &c, &limits, 0.05);
+                    assert!((direct - want).abs() < 1e-9, "{direct} vs {want}");
+                }
+                // Both triplets are read, on many samples each.
+                assert!(
+                    other_read > 1000 && principal_read > 1000,
+                    "{other_read} {principal_read}"
+                );
+            }
+        }
+        // Pure knee flexion 100..130 deg: inside the limits, so no cost.
+        let flexed: Vec<Quat> = (0..=30)
+            .map(|i| quat_axis_angle_deg([0.0, 1.0, 0.0], 100.0 + i as f64))
+            .collect();
+        let limits = JointLimits {
+            range_deg: knee,
+            centroid_deg: None,
+            lambda2: 0.0,
+            axes: None,
+        };
+        let cost = WindowCost::new(&flexed, &limits, 0.05);
+        assert_eq!(cost.eval(&Quat::identity()), 0.0);
+        let (f, g) = cost.data_grad(&Quat::identity());
+        assert_eq!((f, g.norm()), (0.0, 0.0));
+    }
+
+    /// The gradient follows the triplet each sample's cost reads: finite
+    /// differences across the switch between the two (deep flexion, with
+    /// corrections up to 40 deg moving samples from one to the other).
+    #[test]
+    fn gradient_matches_finite_differences_across_the_switch() {
+        let mut rng = ChaCha8Rng::seed_from_u64(15);
+        for (range, centroid) in [
+            ([[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]], None),
+            (
+                [[-50.0, 40.0], [-30.0, 100.0], [-20.0, 50.0]],
+                Some([-5.0, 12.0, -5.0]),
+            ),
+        ] {
+            for axes in test_axes() {
+                let measured = deep_flexion(&mut rng, 300, axes);
+                let limits = engine_limits(range, centroid, axes);
+                check_gradient_on(&measured, limits, &mut rng, 40.0);
+            }
+        }
     }
 
     #[test]

@@ -50,11 +50,16 @@ impl LimitClass {
 
 /// The class of one sample: by the largest excursion over the three axes
 /// (0: within; up to [`NEAR_DEG`]: near; more: beyond). `range_deg` is
-/// `[lower, upper]` per axis X, Y, Z in degrees.
+/// `[lower, upper]` per axis X, Y, Z in degrees. The angles are read in the
+/// box first ([`crate::rotation::read_in_box`]: of the rotation's two Z-Y-X
+/// triplets, the one the box reads).
 pub fn classify(angles_deg: [f64; 3], range_deg: &[[f64; 2]; 3]) -> LimitClass {
-    let worst = excursion(angles_deg, range_deg)
-        .into_iter()
-        .fold(0.0, f64::max);
+    let worst = excursion(
+        crate::rotation::read_in_box(angles_deg, range_deg),
+        range_deg,
+    )
+    .into_iter()
+    .fold(0.0, f64::max);
     if worst <= 0.0 {
         LimitClass::Within
     } else if worst <= NEAR_DEG {

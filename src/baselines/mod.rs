@@ -31,13 +31,17 @@ use rivest::RivestFit;
 use serde::{Deserialize, Serialize};
 
 /// A baseline method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
     /// Rivest (2005), for joints of kind `knee`, on the joint's angles in the
     /// table's convention (its `angle_axes`, docs/method.md section 2.5).
     Rivest {
         /// The joint's [`Joint::angle_axes`].
         angle_axes: [SignedAxis; 3],
+        /// The joint's [`Joint::limit_box`] (degrees): of each rotation's two
+        /// Z-Y-X triplets Rivest fits the one it reads (flexion beyond 90 deg
+        /// on Y).
+        limit_box: Option<[[f64; 2]; 3]>,
     },
     /// Mueller et al. (2017), for joints of kind `elbow`, turning about the
     /// two segment axes `axes` ([`Joint::two_axis_hinge`]).
@@ -62,6 +66,7 @@ pub fn method_for(variant: Variant, joint: &Joint) -> Option<Method> {
     let m = match variant {
         Variant::Rivest => Method::Rivest {
             angle_axes: joint.angle_axes,
+            limit_box: joint.limit_box(),
         },
         Variant::Mueller => Method::Mueller {
             axes: joint.two_axis_hinge(),
@@ -144,7 +149,10 @@ pub fn solve_joint(
     windows: &[Window],
 ) -> BaselineSolution {
     match method {
-        Method::Rivest { angle_axes } => solve_rivest(time_s, measured, windows, angle_axes),
+        Method::Rivest {
+            angle_axes,
+            limit_box,
+        } => solve_rivest(time_s, measured, windows, angle_axes, limit_box),
         Method::Mueller { axes } => solve_mueller(time_s, measured, gyros, windows, axes),
     }
 }
@@ -156,13 +164,20 @@ fn solve_rivest(
     measured: &[Quat],
     windows: &[Window],
     angle_axes: [SignedAxis; 3],
+    limit_box: Option<[[f64; 2]; 3]>,
 ) -> BaselineSolution {
     let axes = TableAxes::of(&angle_axes);
     let angles: Vec<[f64; 3]> = measured
         .iter()
-        .map(|q| match &axes {
-            Some(a) => a.angles(q),
-            None => euler_zyx_deg(q),
+        .map(|q| {
+            let principal = match &axes {
+                Some(a) => a.angles(q),
+                None => euler_zyx_deg(q),
+            };
+            match &limit_box {
+                Some(b) => crate::rotation::read_in_box(principal, b),
+                None => principal,
+            }
         })
         .collect();
     let rotation = |t: [f64; 3]| match &axes {
@@ -355,7 +370,8 @@ mod tests {
         assert_eq!(
             method_for(Variant::Rivest, knee),
             Some(Method::Rivest {
-                angle_axes: knee.angle_axes
+                angle_axes: knee.angle_axes,
+                limit_box: knee.limit_box(),
             })
         );
         assert_eq!(method_for(Variant::Rivest, elbow), None);
@@ -409,6 +425,7 @@ mod tests {
         let sol = solve_joint(
             Method::Rivest {
                 angle_axes: IDENTITY_AXES,
+                limit_box: None,
             },
             &time_s,
             &measured,
@@ -431,6 +448,7 @@ mod tests {
         let one = solve_joint(
             Method::Rivest {
                 angle_axes: IDENTITY_AXES,
+                limit_box: None,
             },
             &time_s,
             &measured,

@@ -187,6 +187,8 @@ pub fn prepare(
     };
     let checks = check_conventions(&trial, setup.model, setup.limits, pose.is_some());
     trial.warnings.extend(checks);
+    let centroids = crate::pose::centroid_check::check_centroids(&trial, setup.model, setup.limits);
+    trial.warnings.extend(centroids);
     Ok(Prepared {
         trial,
         calibration: preparation.calibration.clone(),

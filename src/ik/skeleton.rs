@@ -56,6 +56,10 @@ pub struct Segment {
     pub det: f64,
     /// Values of the table-convention angles, radians (from `default_pose_deg`).
     pub fixed: [f64; 3],
+    /// The joint's limit box (degrees, table convention; [`crate::model::Joint::limit_box`]):
+    /// of a rotation's two Z-Y-X triplets the one it reads starts the solve
+    /// (a hinge knee flexed 120 deg starts at 120, not 60). None for the base.
+    pub limit_box: Option<[[f64; 2]; 3]>,
     /// Weight of this IMU's orientation error.
     pub weight: f64,
     /// Solver columns that move this segment: the base's three, then the
@@ -89,6 +93,7 @@ impl Skeleton {
             frame: crate::rotation::Quat::identity(),
             det: 1.0,
             fixed: [0.0; 3],
+            limit_box: None,
             weight: model.weight(&model.base),
             columns: (0..BASE_COLUMNS).collect(),
         }];
@@ -141,6 +146,7 @@ impl Skeleton {
                     .map_or_else(crate::rotation::Quat::identity, |a| a.q),
                 det: j.table_axes().map_or(1.0, |a| a.det),
                 fixed: j.default_pose_deg.map(f64::to_radians),
+                limit_box: j.limit_box(),
                 weight: model.weight(&j.distal),
                 columns,
             });

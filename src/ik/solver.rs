@@ -149,7 +149,12 @@ impl<'a> Solver<'a> {
             let p = s.parent.expect("only the base has no parent");
             let rel = self.orient[p].inverse() * measured[k];
             let in_table = s.frame.inverse() * rel * s.frame;
-            let e = euler_zyx_deg(&in_table).map(|a| (s.det * a).to_radians());
+            let table = euler_zyx_deg(&in_table).map(|a| s.det * a);
+            let e = match &s.limit_box {
+                Some(b) => crate::rotation::read_in_box(table, b),
+                None => table,
+            }
+            .map(f64::to_radians);
             for (axis, c) in s.coordinate.iter().enumerate() {
                 if let Some(c) = *c {
                     let co = &sk.coordinates[c];

@@ -159,17 +159,18 @@ fn ik_variant_trial_shows_the_coordinates_as_joint_angles() {
         .iter()
         .position(|co| co.label() == "l_knee_y")
         .unwrap();
+    let mut beyond_90 = 0;
     for (i, a) in angles.iter().enumerate() {
         let y = ik.frame(i)[k];
         let hinge = crate::rotation::quat_axis_angle_deg([0.0, 1.0, 0.0], y);
         assert!(angle_between_deg(&quat_from_euler_zyx_deg(*a), &hinge) < 1e-7);
-        // Past 90 deg of flexion the Z-Y-X angles take their other form
-        // (180, 180 - y, 180): the Z-Y-X convention's, not IK's.
-        if y.abs() < 89.0 {
-            assert!(a[0].abs() < 1e-9 && a[2].abs() < 1e-9, "{a:?}");
-            assert!((a[1] - y).abs() < 1e-9);
-        }
+        // Past 90 deg of flexion too: the knee's limit box (Y 0..130) reads
+        // the triplet with the flexion on Y.
+        assert!(a[0].abs() < 1e-9 && a[2].abs() < 1e-9, "{a:?}");
+        assert!((a[1] - y).abs() < 1e-9, "{a:?} vs {y}");
+        beyond_90 += usize::from(y > 90.0);
     }
+    assert!(beyond_90 > 0, "the simulated knee flexes beyond 90 deg");
     let elbow = model.joint("r_elbow").unwrap();
     let a = joint_angles(&c.corrected, elbow).unwrap();
     assert!(a.iter().all(|a| a[1].abs() < 1e-9));

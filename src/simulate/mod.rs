@@ -59,12 +59,13 @@ pub const KNEE_IMUS: [&str; 2] = ["l_thigh", "l_calf"];
 /// Default random misalignment angles, degrees.
 pub const RANDOM_MISALIGNMENT_DEG: [f64; 2] = [5.0, 30.0];
 /// Names accepted by [`preset`].
-pub const PRESETS: [&str; 5] = [
+pub const PRESETS: [&str; 6] = [
     "knee_calf_z15",
     "full_body_clean",
     "full_body_drift",
     "elbow_20",
     "full_body_swing",
+    "full_body_crawl",
 ];
 pub use elbow::{
     elbow_joint, flexion_deg as elbow_flexion_deg, forearm_rate as elbow_forearm_rate,
@@ -124,6 +125,11 @@ pub enum SimKind {
     /// The 13 IMUs of `infant13`, every joint axis one sinusoid over a known
     /// range (see [`swing`]): clean trials whose limits and centroids are known.
     Swing,
+    /// As [`SimKind::FullBody`] (same seed, same motion elsewhere), on hands
+    /// and knees: hip flexion (table Y) 62-98 deg and knee flexion 85-125 deg,
+    /// sums of three sinusoids, mostly beyond 90 deg (the other Z-Y-X triplet:
+    /// docs/method.md section 2.5).
+    Crawl,
 }
 
 /// Which IMU of the knee test is misaligned.
@@ -302,7 +308,7 @@ impl SimConfig {
     pub fn imus(&self, model: &Model) -> Vec<String> {
         match self.kind {
             SimKind::Knee { .. } => KNEE_IMUS.iter().map(|s| s.to_string()).collect(),
-            SimKind::FullBody | SimKind::Swing => model.imus.clone(),
+            SimKind::FullBody | SimKind::Swing | SimKind::Crawl => model.imus.clone(),
             SimKind::Elbow { .. } => elbow::elbow_joint(model)
                 .map(|j| vec![j.proximal.clone(), j.distal.clone()])
                 .unwrap_or_default(),
@@ -427,7 +433,9 @@ impl SimConfig {
 /// and on `r_upper_arm` from 30 s at 0.08 deg/s), `elbow_20` (elbow test, both
 /// IMUs 20 degrees off their hinge axes, 5 min, 50 Hz, seed 3, 0.5 degree noise),
 /// `full_body_swing` (13 IMUs, [`SimKind::Swing`], 60 s, 50 Hz, seed 1, no
-/// misalignment, 0.3 degree noise).
+/// misalignment, 0.3 degree noise), `full_body_crawl` (13 IMUs,
+/// [`SimKind::Crawl`]: hips and knees flexed mostly beyond 90 deg, 60 s, 50 Hz,
+/// seed 1, no misalignment, 0.3 degree noise).
 pub fn preset(name: &str) -> Option<SimConfig> {
     match name {
         "knee_calf_z15" => Some(SimConfig::knee(KneeImu::Calf, KneeAxis::Z, 15.0)),
@@ -453,6 +461,12 @@ pub fn preset(name: &str) -> Option<SimConfig> {
         }),
         "full_body_swing" => Some(SimConfig {
             kind: SimKind::Swing,
+            duration_s: 60.0,
+            misalignment: Misalignment::None,
+            ..SimConfig::full_body(1)
+        }),
+        "full_body_crawl" => Some(SimConfig {
+            kind: SimKind::Crawl,
             duration_s: 60.0,
             misalignment: Misalignment::None,
             ..SimConfig::full_body(1)
@@ -565,7 +579,8 @@ pub fn simulate_with(config: &SimConfig, model: &Model) -> Result<Simulated, Sim
 fn segments_at(config: &SimConfig, model: &Model, time_s: &[f64]) -> Vec<(String, Vec<Quat>)> {
     match config.kind {
         SimKind::Knee { .. } => knee_segments(time_s),
-        SimKind::FullBody => full_body_segments(model, config.seed, time_s),
+        SimKind::FullBody => full_body_segments(model, config.seed, time_s, false),
+        SimKind::Crawl => full_body_segments(model, config.seed, time_s, true),
         SimKind::Elbow { .. } => match elbow::elbow_joint(model) {
             Some(joint) => elbow::segments(joint, time_s),
             None => vec![],
@@ -633,6 +648,7 @@ fn kind_label(kind: &SimKind) -> String {
         SimKind::FullBody => "simulated-full-body".into(),
         SimKind::Elbow { .. } => "simulated-elbow".into(),
         SimKind::Swing => "simulated-swing".into(),
+        SimKind::Crawl => "simulated-crawl".into(),
     }
 }
 
@@ -652,16 +668,31 @@ fn knee_segments(time_s: &[f64]) -> Vec<(String, Vec<Quat>)> {
     ]
 }
 
-/// Base motion plus every joint's angles, chained in model joint order.
-fn full_body_segments(model: &Model, seed: u64, time_s: &[f64]) -> Vec<(String, Vec<Quat>)> {
+/// Base motion plus every joint's angles, chained in model joint order; with
+/// `crawl`, hips and knees flexed deep ([`SimKind::Crawl`], drawn after the
+/// rest so the other joints move as in [`SimKind::FullBody`]).
+fn full_body_segments(
+    model: &Model,
+    seed: u64,
+    time_s: &[f64],
+    crawl: bool,
+) -> Vec<(String, Vec<Quat>)> {
     let table = LimitTable::default_table();
     let mut r = rng(seed, Stream::Motion);
     let base = motion::BaseMotion::random(&mut r);
-    let joints: Vec<motion::JointMotion> = model
+    let mut joints: Vec<motion::JointMotion> = model
         .joints
         .iter()
         .map(|j| motion::joint_motion(&mut r, &table, j))
         .collect();
+    if crawl {
+        joints = model
+            .joints
+            .iter()
+            .zip(joints)
+            .map(|(j, m)| motion::crawl_motion(&mut r, j, m))
+            .collect();
+    }
     chain_segments(model, &base, time_s, |k, t| joints[k].angles_at(t))
 }
 

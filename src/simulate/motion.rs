@@ -132,6 +132,35 @@ pub(super) fn joint_motion(rng: &mut ChaCha8Rng, table: &LimitTable, joint: &Joi
     JointMotion { axes }
 }
 
+/// Hip flexion of [`crawl_motion`]: centre and peak deviation, degrees
+/// (reaches 62-98 deg; Table 3-2's hip Y is -30..100).
+pub(super) const CRAWL_HIP_Y_DEG: [f64; 2] = [80.0, 18.0];
+/// Knee flexion of [`crawl_motion`]: centre and peak deviation, degrees
+/// (reaches 96-126 deg; Table 3-2's knee Y is 0..130). It stays clear of
+/// 90 deg, where Z-Y-X angles are singular (docs/method.md section 2.3): a
+/// knee's +-5 deg X and Z limits are crossed by noise alone there (0.3 deg
+/// of orientation noise reads as several degrees of X and Z within about
+/// 6 deg of 90 deg), whichever triplet is read.
+pub(super) const CRAWL_KNEE_Y_DEG: [f64; 2] = [111.0, 15.0];
+
+/// A joint's motion on hands and knees: `motion` with a hip's or a knee's
+/// flexion (table Y) replaced by a deep one, mostly beyond 90 deg
+/// ([`CRAWL_HIP_Y_DEG`], [`CRAWL_KNEE_Y_DEG`]); other joints unchanged.
+pub(super) fn crawl_motion(
+    rng: &mut ChaCha8Rng,
+    joint: &Joint,
+    motion: JointMotion,
+) -> JointMotion {
+    let [centre, peak] = match joint.kind.as_str() {
+        "hip" => CRAWL_HIP_Y_DEG,
+        "knee" => CRAWL_KNEE_Y_DEG,
+        _ => return motion,
+    };
+    let [x, _, z] = motion.axes;
+    let y = Signal::random(rng, centre, peak, WAVES_PER_AXIS, JOINT_PERIOD_S);
+    JointMotion { axes: [x, y, z] }
+}
+
 /// Motion of the base segment (lower back) of a crawling infant: slow heading
 /// changes about the global vertical, small pitch and roll.
 #[derive(Debug, Clone)]

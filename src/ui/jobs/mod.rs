@@ -97,6 +97,8 @@ pub fn load_trial(
             pipeline::load_file(&input, &model).map_err(shown)?;
         drop(input);
         trial.name = file.to_string();
+        let centroids = crate::pose::centroid_check::check_centroids(&trial, &model, limits);
+        trial.warnings.extend(centroids);
         let (truth, truth_error) = match load_truth_beside(path, &model) {
             None => (None, None),
             Some(Ok(t)) => match t.check_against(&trial) {

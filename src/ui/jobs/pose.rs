@@ -20,6 +20,13 @@ pub fn calibrate_job(
         .map(|(mut trial, record)| {
             let checks = check_conventions(&trial, &loaded.model, limits, true);
             trial.warnings.extend(checks);
+            // The load's centroid warnings were of the uncalibrated angles.
+            trial
+                .warnings
+                .retain(|w| !crate::pose::centroid_check::is_centroid_warning(w));
+            let centroids =
+                crate::pose::centroid_check::check_centroids(&trial, &loaded.model, limits);
+            trial.warnings.extend(centroids);
             let before = trial_figures(&trial, None, loaded.truth.as_ref(), &loaded.model, limits);
             Arc::new(Loaded {
                 trial,
