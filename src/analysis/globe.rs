@@ -468,6 +468,41 @@ pub fn globe_raster(
     out
 }
 
+/// The edge of a swing-twist region ([`crate::limits::swing_twist`]) on the
+/// sphere: the directions of the twist axis (the segment's long axis) turned
+/// by the swings on the region's edge, `per` points (closed: the first
+/// repeated last). Unit vectors in the table's axes, as [`direction`]'s; for
+/// a twist about X they are the segment's true directions, like the points.
+pub fn swing_outline(
+    st: &crate::limits::swing_twist::SwingTwistLimits,
+    per: usize,
+) -> Vec<[f64; 3]> {
+    let per = per.max(4);
+    let [a1, a2] = crate::limits::swing_twist::swing_axes(st.twist_axis);
+    let [h1, h2] = st.half_deg;
+    (0..=per)
+        .map(|k| {
+            let th = k as f64 * std::f64::consts::TAU / per as f64;
+            let (s, c) = th.sin_cos();
+            let (u, v) = match st.corner_deg {
+                None => (h1 * c, h2 * s),
+                // The inner box's corner on this side, plus the rounding.
+                Some(r) => (
+                    (h1 - r).copysign(c) + r * c,
+                    (h2 - r).copysign(s) + r * s,
+                ),
+            };
+            let mut rv = nalgebra::Vector3::zeros();
+            rv[a1] = (st.centre_deg[0] + u).to_radians();
+            rv[a2] = (st.centre_deg[1] + v).to_radians();
+            let mut e = nalgebra::Vector3::zeros();
+            e[st.twist_axis] = 1.0;
+            let d = crate::rotation::Quat::from_scaled_axis(rv) * e;
+            [d[0], d[1], d[2]]
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -702,5 +737,28 @@ mod tests {
             globe_raster(&back, &KNEE, axes, &view, Colouring::Limits, grid(50)).count(),
             0
         );
+    }
+
+    #[test]
+    fn swing_outline_of_the_knee_box_is_the_band_for_a_twist_about_x() {
+        // A knee-like box (flexion 0..80 about Y, +-5 about Z, twist about X):
+        // its edge's directions have globographic angles on the band's edge.
+        let st = crate::limits::swing_twist::SwingTwistLimits {
+            twist_axis: 0,
+            centre_deg: [40.0, 0.0],
+            half_deg: [40.0, 5.0],
+            corner_deg: Some(0.0),
+            twist_deg: [-5.0, 5.0],
+            edge_twist_deg: [-5.0, 5.0],
+        };
+        let axes = JointAxes::default();
+        for d in swing_outline(&st, 64) {
+            assert!((d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - 1.0).abs() < 1e-12);
+            let [f, a] = globographic_angles(d, axes);
+            // Flexion within its range, ab/adduction within about its range
+            // (a swing's components are not the Euler angles off the axes).
+            assert!((-1e-9..=80.0 + 1e-9).contains(&f), "{f}");
+            assert!(a.abs() <= 5.5, "{a}");
+        }
     }
 }
