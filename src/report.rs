@@ -268,7 +268,6 @@ pub fn format_text(r: &TrialReport) -> String {
     let _ = writeln!(
         out,
         "{}: {} samples, {:.1} s at {:.1} Hz, {} IMUs; model {}; limits {}{} (sha256 {})",
-
         r.trial,
         r.samples,
         r.duration_s,

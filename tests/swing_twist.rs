@@ -88,23 +88,64 @@ fn malformed_rows_are_located_errors() {
     let ok = "knee,X,m,65,0,65,5,,-5,5,,,,,,0";
     LimitTable::parse(&format!("{}\n{ok}\n", HEADER.join(",")), "st.csv").unwrap();
     let cases: [(&str, u64, usize, &str); 10] = [
-        ("knee,W,m,65,0,65,5,,-5,5,,,,,,0", 3, 2, "twist axis X, Y or Z"),
-        ("knee,X,m,abc,0,65,5,,-5,5,,,,,,0", 3, 4, "swing_1_centre_deg"),
-        ("knee,X,m,65,0,0,5,,-5,5,,,,,,0", 3, 6, "swing_1_half_deg > 0"),
-        ("knee,X,m,65,0,65,5,9,-5,5,,,,,,0", 3, 8, "at most the smaller half-angle"),
-        ("knee,X,m,65,0,65,5,,5,-5,,,,,,0", 3, 10, "twist_upper_deg > twist_lower_deg"),
-        ("knee,X,m,65,0,65,5,,-5,5,-3,,,,,0", 3, 12, "edge_twist_upper_deg"),
-        ("knee,X,m,65,0,65,5,,-5,5,,,1,,,0", 3, 14, "all three centroid angles"),
+        (
+            "knee,W,m,65,0,65,5,,-5,5,,,,,,0",
+            3,
+            2,
+            "twist axis X, Y or Z",
+        ),
+        (
+            "knee,X,m,abc,0,65,5,,-5,5,,,,,,0",
+            3,
+            4,
+            "swing_1_centre_deg",
+        ),
+        (
+            "knee,X,m,65,0,0,5,,-5,5,,,,,,0",
+            3,
+            6,
+            "swing_1_half_deg > 0",
+        ),
+        (
+            "knee,X,m,65,0,65,5,9,-5,5,,,,,,0",
+            3,
+            8,
+            "at most the smaller half-angle",
+        ),
+        (
+            "knee,X,m,65,0,65,5,,5,-5,,,,,,0",
+            3,
+            10,
+            "twist_upper_deg > twist_lower_deg",
+        ),
+        (
+            "knee,X,m,65,0,65,5,,-5,5,-3,,,,,0",
+            3,
+            12,
+            "edge_twist_upper_deg",
+        ),
+        (
+            "knee,X,m,65,0,65,5,,-5,5,,,1,,,0",
+            3,
+            14,
+            "all three centroid angles",
+        ),
         ("knee,X,m,65,0,65,5,,-5,5,,,,,,-1", 3, 16, "lambda2"),
         ("knee,X,m,65,0,65,5,,-5,5,,,,,", 3, 16, "fields"),
-        ("knee,X,m,65,0,65,5,,-5,200,,,,,,0", 3, 10, "within -180..180"),
+        (
+            "knee,X,m,65,0,65,5,,-5,200,,,,,,0",
+            3,
+            10,
+            "within -180..180",
+        ),
     ];
     for (row, line, column, what) in cases {
         let e = parse_err(&format!("{row}\n"));
         assert_eq!((e.line, e.column), (line, column), "{row}: {e}");
         assert!(e.message.contains(what), "{row}: {e}");
         assert!(
-            e.to_string().starts_with(&format!("st.csv:{line}:{column}:")),
+            e.to_string()
+                .starts_with(&format!("st.csv:{line}:{column}:")),
             "{e}"
         );
     }
@@ -212,7 +253,12 @@ fn test_limits() -> Vec<JointLimits> {
     let mut out = Vec::new();
     for name in ["l_knee", "r_elbow", "r_hip", "l_shoulder", "l_ankle"] {
         let j = model.joint(name).unwrap();
-        out.push(table.joint_limits(&j.name, &j.kind, true).unwrap().in_table_axes(j));
+        out.push(
+            table
+                .joint_limits(&j.name, &j.kind, true)
+                .unwrap()
+                .in_table_axes(j),
+        );
     }
     // A twist range that narrows towards the edge, a cone and an offset centre.
     let mut knee = out[0];
@@ -296,7 +342,10 @@ fn the_gradient_is_the_finite_difference() {
             }
         }
     }
-    assert!(kinks < 10 && checked > 200, "{kinks} kinks, {checked} checked");
+    assert!(
+        kinks < 10 && checked > 200,
+        "{kinks} kinks, {checked} checked"
+    );
 }
 
 const ANGLES_DEG: [f64; 6] = [5.0, 10.0, 15.0, 20.0, 25.0, 30.0];
@@ -452,4 +501,105 @@ fn wxyz_of_the_cost_samples_is_sign_invariant() {
         let w = wxyz(&q);
         assert_eq!(l.excursion(w), l.excursion(w.map(|c| -c)));
     }
+}
+
+/// The command line with a swing-twist table: `correct` refuses a heading
+/// variant with a located error (exit 3), corrects with `drift` and records
+/// the model in the sidecar, which `--from-sidecar` reproduces byte for byte;
+/// `report` names the model; `plot globe` draws the region's edge.
+#[test]
+fn the_command_line_selects_and_records_a_swing_twist_table() {
+    use std::process::Command;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let table = root.join("joint_limits/swing_twist.csv");
+    let trial = root.join("sample_trials/elbow_20.csv.gz");
+    let dir = tempfile::tempdir().unwrap();
+    let acmw = || {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_acmw"));
+        c.current_dir(dir.path());
+        c
+    };
+    let out = acmw()
+        .args([
+            "correct",
+            "--quiet",
+            "--variant",
+            "drift-heading",
+            "--limits",
+        ])
+        .arg(&table)
+        .arg(&trial)
+        .arg("-o")
+        .arg(dir.path().join("h.csv"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("swing_twist.csv") && err.contains("takes Euler limit tables only"),
+        "{err}"
+    );
+    let first = dir.path().join("d.csv");
+    let out = acmw()
+        .args(["correct", "--quiet", "--variant", "drift", "--limits"])
+        .arg(&table)
+        .arg(&trial)
+        .arg("-o")
+        .arg(&first)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let sidecar = dir.path().join("d.csv.acmw.json");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&sidecar).unwrap()).unwrap();
+    assert_eq!(json["limits"]["model"], "swing-twist");
+    let again = dir.path().join("again.csv");
+    let out = acmw()
+        .args(["correct", "--quiet", "--from-sidecar"])
+        .arg(&sidecar)
+        .arg(&trial)
+        .arg("-o")
+        .arg(&again)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(&first).unwrap(),
+        std::fs::read(&again).unwrap()
+    );
+    let out = acmw()
+        .args(["report", "--variant", "basic", "--limits"])
+        .arg(&table)
+        .arg(&trial)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("swing_twist.csv (swing-twist)"), "{text}");
+    let svg = dir.path().join("g.svg");
+    let out = acmw()
+        .args(["plot", "globe", "--joint", "l_elbow", "--limits"])
+        .arg(&table)
+        .arg(&trial)
+        .arg("-o")
+        .arg(&svg)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("#D06000"), "the region's edge");
 }

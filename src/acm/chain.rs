@@ -326,7 +326,10 @@ fn plan_joints(
         .as_ref()
         .and_then(|_| crate::limits::swing_twist::refusal(variant));
     for (k, joint) in model.joints.iter().enumerate() {
-        match refused.clone().or_else(|| skip_reason(trial, joint, limits)) {
+        match refused
+            .clone()
+            .or_else(|| skip_reason(trial, joint, limits))
+        {
             Some(reason) => skipped.push(SkippedJoint {
                 joint: joint.name.clone(),
                 reason,

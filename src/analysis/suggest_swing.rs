@@ -218,10 +218,17 @@ mod tests {
                     / coords.len() as f64
             };
             for k in 0..2 {
-                let (lo, hi) = (l.centre_deg[k] - l.half_deg[k], l.centre_deg[k] + l.half_deg[k]);
+                let (lo, hi) = (
+                    l.centre_deg[k] - l.half_deg[k],
+                    l.centre_deg[k] + l.half_deg[k],
+                );
                 assert!(inside(k, lo, hi) >= 0.9, "{} swing {k}", r.joint);
             }
-            assert!(inside(2, l.twist_deg[0], l.twist_deg[1]) >= 0.9, "{} twist", r.joint);
+            assert!(
+                inside(2, l.twist_deg[0], l.twist_deg[1]) >= 0.9,
+                "{} twist",
+                r.joint
+            );
         }
         assert!(with_samples >= 5, "{with_samples}");
     }

@@ -188,7 +188,10 @@ impl SwingTwistLimits {
         let (d, near) = match self.corner_deg {
             Some(r) => {
                 // The box shrunk by r, then every point within r of it.
-                let q = [(p[0].abs() - (a - r)).max(0.0), (p[1].abs() - (b - r)).max(0.0)];
+                let q = [
+                    (p[0].abs() - (a - r)).max(0.0),
+                    (p[1].abs() - (b - r)).max(0.0),
+                ];
                 let len = (q[0] * q[0] + q[1] * q[1]).sqrt();
                 if len <= r {
                     return S::from(0.0);
@@ -212,10 +215,7 @@ impl SwingTwistLimits {
         }
         let n = [(p[0] - near[0]) / d, (p[1] - near[1]) / d];
         // d = n . (swing - centre - near), with near fixed to first order.
-        let dc = [
-            self.centre_deg[0] + near[0],
-            self.centre_deg[1] + near[1],
-        ];
+        let dc = [self.centre_deg[0] + near[0], self.centre_deg[1] + near[1]];
         S::from(n[0]) * (swing[0] - S::from(dc[0])) + S::from(n[1]) * (swing[1] - S::from(dc[1]))
     }
 }
@@ -357,7 +357,12 @@ fn out_put<S: Scalar>(out: &mut [S; 3], t: usize, i: usize, j: usize, si: S, sj:
 /// The arithmetic the model's formulas need: plain numbers, and numbers
 /// carrying their derivatives along three directions.
 trait Scalar:
-    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
 {
     fn from(v: f64) -> Self;
     fn val(self) -> f64;
@@ -410,6 +415,8 @@ impl Sub for Dual {
 
 impl Mul for Dual {
     type Output = Dual;
+    // The product rule: (uv)' = u'v + uv'.
+    #[allow(clippy::suspicious_arithmetic_impl)]
     fn mul(self, o: Dual) -> Dual {
         Dual {
             v: self.v * o.v,
@@ -420,6 +427,8 @@ impl Mul for Dual {
 
 impl Div for Dual {
     type Output = Dual;
+    // The quotient rule: (u/v)' = (u' - (u/v) v') / v.
+    #[allow(clippy::suspicious_arithmetic_impl)]
     fn div(self, o: Dual) -> Dual {
         let inv = 1.0 / o.v;
         Dual {
@@ -619,7 +628,10 @@ pub(super) fn parse_row(
             _ => Err(err(
                 line,
                 col + 1,
-                format!("expected {} in degrees within {lo}..{hi}, found '{s}'", HEADER[col]),
+                format!(
+                    "expected {} in degrees within {lo}..{hi}, found '{s}'",
+                    HEADER[col]
+                ),
             )),
         }
     };
@@ -632,14 +644,14 @@ pub(super) fn parse_row(
     };
     let centre_deg = [number(3, -180.0, 180.0)?, number(4, -180.0, 180.0)?];
     let mut half_deg = [0.0; 2];
-    for k in 0..2 {
+    for (k, half) in half_deg.iter_mut().enumerate() {
         let col = 5 + k;
-        half_deg[k] = number(col, 0.0, 180.0)?;
-        if half_deg[k] <= 0.0 {
+        *half = number(col, 0.0, 180.0)?;
+        if *half <= 0.0 {
             return Err(err(
                 line,
                 col + 1,
-                format!("expected {} > 0 degrees, found {}", HEADER[col], half_deg[k]),
+                format!("expected {} > 0 degrees, found {half}", HEADER[col]),
             ));
         }
     }
@@ -651,17 +663,29 @@ pub(super) fn parse_row(
             (Some(lo), Some(hi)) => Err(err(
                 line,
                 c + 2,
-                format!("expected {} > {}, found {hi} <= {lo}", HEADER[c + 1], HEADER[c]),
+                format!(
+                    "expected {} > {}, found {hi} <= {lo}",
+                    HEADER[c + 1],
+                    HEADER[c]
+                ),
             )),
             (None, Some(_)) => Err(err(
                 line,
                 c + 1,
-                format!("expected {} as {} is set, found nothing", HEADER[c], HEADER[c + 1]),
+                format!(
+                    "expected {} as {} is set, found nothing",
+                    HEADER[c],
+                    HEADER[c + 1]
+                ),
             )),
             (Some(_), None) => Err(err(
                 line,
                 c + 2,
-                format!("expected {} as {} is set, found nothing", HEADER[c + 1], HEADER[c]),
+                format!(
+                    "expected {} as {} is set, found nothing",
+                    HEADER[c + 1],
+                    HEADER[c]
+                ),
             )),
         }
     };
@@ -672,7 +696,9 @@ pub(super) fn parse_row(
             return Err(err(
                 line,
                 8,
-                format!("expected swing_corner_deg at most the smaller half-angle ({most}), found {r}"),
+                format!(
+                    "expected swing_corner_deg at most the smaller half-angle ({most}), found {r}"
+                ),
             ));
         }
     }
@@ -707,7 +733,10 @@ pub(super) fn parse_row(
             return Err(err(
                 line,
                 16,
-                format!("expected lambda2 as a finite number >= 0, found '{}'", &rec[15]),
+                format!(
+                    "expected lambda2 as a finite number >= 0, found '{}'",
+                    &rec[15]
+                ),
             ))
         }
     };
@@ -787,8 +816,14 @@ mod tests {
 
     #[test]
     fn ellipse_distance_is_the_nearest_point() {
-        for (a, b) in [(65.0, 5.0), (5.0, 65.0), (30.0, 30.0), (40.0, 10.0)] {
-            for p in [[80.0, 3.0], [-10.0, -20.0], [0.0, 90.0], [100.0, 0.0], [20.0, 40.0]] {
+        for (a, b) in [(65.0_f64, 5.0_f64), (5.0, 65.0), (30.0, 30.0), (40.0, 10.0)] {
+            for p in [
+                [80.0, 3.0],
+                [-10.0, -20.0],
+                [0.0, 90.0],
+                [100.0, 0.0],
+                [20.0, 40.0],
+            ] {
                 if (p[0] / a).powi(2) + (p[1] / b).powi(2) <= 1.0 {
                     continue;
                 }
@@ -801,7 +836,10 @@ mod tests {
                         ((a * th.cos() - p[0]).powi(2) + (b * th.sin() - p[1]).powi(2)).sqrt()
                     })
                     .fold(f64::INFINITY, f64::min);
-                assert!(d <= best + 1e-9 && d > best - 1e-3, "{a} {b} {p:?}: {d} vs {best}");
+                assert!(
+                    d <= best + 1e-9 && d > best - 1e-3,
+                    "{a} {b} {p:?}: {d} vs {best}"
+                );
             }
         }
     }
@@ -849,9 +887,11 @@ mod tests {
             assert!((cone.excursion(wxyz(&q)) - 20.0).abs() < 1e-9);
         }
         // On the cone's edge the twist range is the edge's.
-        let edge = quat_axis_angle_deg([1.0, 0.0, 0.0], 30.0) * quat_axis_angle_deg([0.0, 0.0, 1.0], 5.0);
+        let edge =
+            quat_axis_angle_deg([1.0, 0.0, 0.0], 30.0) * quat_axis_angle_deg([0.0, 0.0, 1.0], 5.0);
         assert!((cone.excursion(wxyz(&edge)) - 5.0).abs() < 1e-9);
-        let half = quat_axis_angle_deg([1.0, 0.0, 0.0], 15.0) * quat_axis_angle_deg([0.0, 0.0, 1.0], 5.0);
+        let half =
+            quat_axis_angle_deg([1.0, 0.0, 0.0], 15.0) * quat_axis_angle_deg([0.0, 0.0, 1.0], 5.0);
         assert_eq!(cone.excursion(wxyz(&half)), 0.0);
         assert_eq!(cone.twist_range(0.5), [-15.0, 5.0]);
     }
@@ -880,7 +920,11 @@ mod tests {
         let mut checked = 0;
         for lim in lims {
             for k in 0..60 {
-                let axis = [(k as f64 * 1.3).sin(), (k as f64 * 0.7).cos(), (k as f64 * 2.1).sin()];
+                let axis = [
+                    (k as f64 * 1.3).sin(),
+                    (k as f64 * 0.7).cos(),
+                    (k as f64 * 2.1).sin(),
+                ];
                 let q = quat_axis_angle_deg(axis, 5.0 + 2.7 * k as f64);
                 let (f, g) = lim.excursion_grad(wxyz(&q));
                 assert_eq!(f, lim.excursion(wxyz(&q)));
@@ -894,7 +938,11 @@ mod tests {
                     if (up - down).abs() > tol {
                         continue; // a kink within the step
                     }
-                    assert!((0.5 * (up + down) - g[c]).abs() < tol, "{lim:?} {k} {c}: {up} vs {}", g[c]);
+                    assert!(
+                        (0.5 * (up + down) - g[c]).abs() < tol,
+                        "{lim:?} {k} {c}: {up} vs {}",
+                        g[c]
+                    );
                     checked += 1;
                 }
             }
