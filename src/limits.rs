@@ -13,6 +13,11 @@
 //! the joint has no centroid; `lambda2` weighs the centroid term and is the same on
 //! the joint's three rows. The global settings (`lambda1`, window and hop) live in
 //! `joint_limits/settings.toml` (see [`Settings`]).
+//!
+//! A table may instead be in the swing-twist model ([`swing_twist`]): its
+//! header, `joint,twist_axis,...`, says so, and the loader decides by it.
+
+pub mod swing_twist;
 
 use crate::model::Model;
 use crate::trial::precision::Precision;
@@ -32,6 +37,10 @@ pub const BUILTIN_TABLES: &[(&str, &str)] = &[
     (
         "table_3_1.csv",
         include_str!("../joint_limits/table_3_1.csv"),
+    ),
+    (
+        "swing_twist.csv",
+        include_str!("../joint_limits/swing_twist.csv"),
     ),
 ];
 
@@ -76,6 +85,10 @@ pub struct JointLimits {
     /// `angle_axes`, and every use outside the engine); `Some(axes)` for those
     /// of `Q^T R Q` (the engine's costs, [`JointLimits::in_table_axes`]).
     pub axes: Option<crate::model::TableAxes>,
+    /// The swing-twist limits when the table is of that model
+    /// ([`swing_twist`]): the costs then use them instead of `range_deg`
+    /// (which holds their box in Z-Y-X angles, for views and checks).
+    pub swing_twist: Option<swing_twist::SwingTwistLimits>,
 }
 
 impl JointLimits {
@@ -99,6 +112,9 @@ impl JointLimits {
                 .map(|c| if flip { c.map(|a| -a) } else { c }),
             lambda2: self.lambda2,
             axes: Some(axes),
+            swing_twist: self
+                .swing_twist
+                .map(|s| if flip { s.mirrored() } else { s }),
         }
     }
 
@@ -119,6 +135,10 @@ pub struct LimitTable {
     #[serde(default)]
     pub preamble: Vec<String>,
     pub rows: Vec<LimitRow>,
+    /// The swing-twist rows when the table is of that model; `rows` then
+    /// holds their boxes in Z-Y-X angles ([`swing_twist::SwingTwistRow::euler_rows`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub swing_twist: Option<Vec<swing_twist::SwingTwistRow>>,
 }
 
 /// A limit table or settings problem, located in its file (line 0 when the
@@ -440,6 +460,9 @@ impl LimitTable {
             .map_err(|e| err(1, 0, format!("cannot read the header: {e}")))?
             .clone();
         let found: Vec<&str> = header.iter().collect();
+        if found.get(1) == Some(&"twist_axis") {
+            return parse_swing_twist(text, rdr, &found, &err);
+        }
         if found != HEADER {
             // The first field that differs (1-based), or the first one missing.
             let column = found
@@ -481,7 +504,11 @@ impl LimitTable {
             rows.push(parse_row(&rec, line, &err)?);
             lines.push(line);
         }
-        let table = LimitTable { preamble, rows };
+        let table = LimitTable {
+            preamble,
+            rows,
+            swing_twist: None,
+        };
         table.check_consistency(origin, &lines)?;
         Ok(table)
     }
@@ -606,12 +633,30 @@ impl LimitTable {
         } else {
             0.0
         };
+        let swing_twist = match &self.swing_twist {
+            None => None,
+            Some(st) => {
+                let find = |name: &str| st.iter().find(|r| r.joint == name);
+                Some(find(joint).or_else(|| find(kind))?.limits)
+            }
+        };
         Some(JointLimits {
             range_deg: rows.map(|r| [r.lower_deg, r.upper_deg]),
             centroid_deg: centroid,
             lambda2,
             axes: None,
+            swing_twist,
         })
+    }
+
+    /// The table's limit model: `euler-zyx` (a box on Z-Y-X angles) or
+    /// `swing-twist` ([`swing_twist`]), as reports and sidecars name it.
+    pub fn model_name(&self) -> &'static str {
+        if self.swing_twist.is_some() {
+            "swing-twist"
+        } else {
+            "euler-zyx"
+        }
     }
 
     /// The table as CSV text, comments first, as saved.
@@ -627,6 +672,15 @@ impl LimitTable {
 
     /// Header and rows only, in canonical form: what [`LimitTable::hash`] covers.
     pub fn rows_csv(&self) -> String {
+        if let Some(st) = &self.swing_twist {
+            let mut out = swing_twist::HEADER.join(",");
+            out.push('\n');
+            for r in st {
+                out.push_str(&r.to_csv());
+                out.push('\n');
+            }
+            return out;
+        }
         let mut out = HEADER.join(",");
         out.push('\n');
         for r in &self.rows {
@@ -654,7 +708,7 @@ impl LimitTable {
 
 /// A text cell as CSV: quoted (quotes doubled) when it holds a separator, a
 /// quote or a line break, or starts with the comment sign, so that it reads back as is.
-fn csv_field(text: &str) -> std::borrow::Cow<'_, str> {
+pub(crate) fn csv_field(text: &str) -> std::borrow::Cow<'_, str> {
     if text.contains([',', '"', '\n', '\r']) || text.starts_with('#') {
         format!("\"{}\"", text.replace('"', "\"\"")).into()
     } else {
@@ -737,6 +791,75 @@ fn parse_row(
         upper_deg,
         centroid_deg,
         lambda2,
+    })
+}
+
+/// The rest of [`LimitTable::parse`] for a table whose header names the
+/// swing-twist model (`found`): its rows, each joint once, and their boxes as
+/// the Euler rows.
+fn parse_swing_twist(
+    text: &str,
+    mut rdr: csv::Reader<&[u8]>,
+    found: &[&str],
+    err: &dyn Fn(u64, usize, String) -> LimitsError,
+) -> Result<LimitTable, LimitsError> {
+    let want = swing_twist::HEADER;
+    if found != want {
+        let column = found
+            .iter()
+            .zip(want)
+            .position(|(f, h)| *f != h)
+            .unwrap_or(found.len().min(want.len()))
+            + 1;
+        return Err(err(
+            1,
+            column,
+            format!(
+                "expected the swing-twist header `{}`, found `{}`",
+                want.join(","),
+                found.join(",")
+            ),
+        ));
+    }
+    let preamble = text
+        .lines()
+        .take_while(|l| l.trim_start().starts_with('#'))
+        .map(str::to_string)
+        .collect();
+    let mut st: Vec<swing_twist::SwingTwistRow> = Vec::new();
+    let mut lines: Vec<u64> = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            let column = match e.kind() {
+                csv::ErrorKind::UnequalLengths { len, .. } => (*len as usize).min(want.len()) + 1,
+                _ => 1,
+            };
+            err(
+                line,
+                column,
+                format!("expected {} fields per row: {e}", want.len()),
+            )
+        })?;
+        let line = rec.position().map_or(0, |p| p.line());
+        let row = swing_twist::parse_row(&rec, line, err)?;
+        if let Some(i) = st.iter().position(|r| r.joint == row.joint) {
+            return Err(err(
+                line,
+                1,
+                format!(
+                    "joint '{}' appears twice (first on line {}); expected one row per joint",
+                    row.joint, lines[i]
+                ),
+            ));
+        }
+        st.push(row);
+        lines.push(line);
+    }
+    Ok(LimitTable {
+        preamble,
+        rows: st.iter().flat_map(|r| r.euler_rows()).collect(),
+        swing_twist: Some(st),
     })
 }
 

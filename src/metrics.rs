@@ -205,6 +205,7 @@ mod tests {
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         }
     }
 

@@ -43,6 +43,10 @@ pub struct TrialReport {
     pub model: String,
     pub limits_source: String,
     pub limits_sha256: String,
+    /// The limit table's model when it is not the Euler box
+    /// (`swing-twist`); absent for Euler tables.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limits_model: Option<String>,
     pub settings: Settings,
     /// Whether a ground truth was compared against.
     pub truth: bool,
@@ -103,6 +107,11 @@ impl ReportInput<'_> {
             model: self.model.name.clone(),
             limits_source: self.limits_source.to_string(),
             limits_sha256: self.limits.hash(),
+            limits_model: self
+                .limits
+                .swing_twist
+                .as_ref()
+                .map(|_| self.limits.model_name().to_string()),
             settings: *self.settings,
             truth: self.truth.is_some(),
             uncorrected: trial_figures(t, None, self.truth, self.model, self.limits),
@@ -258,7 +267,7 @@ pub fn format_text(r: &TrialReport) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "{}: {} samples, {:.1} s at {:.1} Hz, {} IMUs; model {}; limits {} (sha256 {})",
+        "{}: {} samples, {:.1} s at {:.1} Hz, {} IMUs; model {}; limits {}{} (sha256 {})",
         r.trial,
         r.samples,
         r.duration_s,
@@ -266,6 +275,10 @@ pub fn format_text(r: &TrialReport) -> String {
         r.imus.len(),
         r.model,
         r.limits_source,
+        r.limits_model
+            .as_ref()
+            .map(|m| format!(" ({m})"))
+            .unwrap_or_default(),
         &r.limits_sha256[..12]
     );
     let _ = writeln!(

@@ -24,6 +24,10 @@ pub struct TableRecord {
     pub sha256: String,
     /// The table itself, as CSV text.
     pub csv: String,
+    /// The table's limit model when it is not the Euler box (`swing-twist`,
+    /// as its CSV header also says); absent for Euler tables.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
 }
 
 /// The input trial of a correction.
@@ -132,6 +136,10 @@ impl Sidecar {
                 source: limits_source.into(),
                 sha256: limits.hash(),
                 csv: limits.to_csv(),
+                model: limits
+                    .swing_twist
+                    .as_ref()
+                    .map(|_| limits.model_name().to_string()),
             },
             joints: correction.joints.clone(),
             skipped: correction.skipped.clone(),
@@ -198,6 +206,16 @@ impl Sidecar {
             return Err(at(
                 &["limits", "sha256"],
                 "limits.csv does not match limits.sha256 (the sidecar was edited?)".into(),
+            ));
+        }
+        let recorded = self.limits.model.as_deref().unwrap_or("euler-zyx");
+        if recorded != table.model_name() {
+            return Err(at(
+                &["limits", "model"],
+                format!(
+                    "expected the model of limits.csv ('{}'), found '{recorded}'",
+                    table.model_name()
+                ),
             ));
         }
         table

@@ -195,7 +195,11 @@ prop_compose! {
             .filter(|rows| seen.insert(rows[0].joint.clone()))
             .flatten()
             .collect();
-        LimitTable { preamble, rows }
+        LimitTable {
+            preamble,
+            rows,
+            swing_twist: None,
+        }
     }
 }
 

@@ -120,6 +120,7 @@ fn written_limit_tables_and_settings_read_back() {
         let table = LimitTable {
             preamble: vec!["# a comment".into()],
             rows,
+            swing_twist: None,
         };
         let back = LimitTable::parse(&table.to_csv(), "t.csv")
             .unwrap_or_else(|e| panic!("case {case}: {e}\n{}", table.to_csv()));

@@ -551,6 +551,8 @@ pub struct WindowCost {
     lambda1: f64,
     /// The limits' axes: a correction `C` is evaluated as `Q^T C Q`.
     axes: Option<crate::model::TableAxes>,
+    /// Swing-twist limits, in place of `terms`' ranges (its centroid stays).
+    swing: Option<super::swing_cost::SwingTerms>,
 }
 
 impl WindowCost {
@@ -578,6 +580,7 @@ impl WindowCost {
             terms: LimitTerms::new(limits),
             lambda1,
             axes: limits.axes,
+            swing: limits.swing_twist.map(super::swing_cost::SwingTerms::new),
         }
     }
 
@@ -639,7 +642,15 @@ impl WindowCost {
         let mut sum = 0.0;
         let mut g = [0.0; 3];
         let mut e = [[0.0; BLOCK]; 5];
-        let mut start = 0;
+        // Swing-twist limits take the samples' excursions in place of the
+        // Euler ranges' loop below, which then has nothing left to do.
+        let mut start = match &self.swing {
+            Some(st) => {
+                sum += st.sum(&self.samples.q, c, grad.is_some().then_some(&mut g));
+                n
+            }
+            None => 0,
+        };
         while start < n {
             let len = BLOCK.min(n - start);
             let row = |k: usize| &r[k][start..start + len];
@@ -773,18 +784,21 @@ mod tests {
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         });
         check_fast_equals_direct(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
             axes: None,
+            swing_twist: None,
         });
         check_fast_equals_direct(JointLimits {
             range_deg: [[-180.0, 180.0], [-90.0, 90.0], [100.0, 120.0]],
             centroid_deg: Some([0.0, 5.0, 0.0]),
             lambda2: 30.0,
             axes: None,
+            swing_twist: None,
         });
     }
 
@@ -849,6 +863,7 @@ mod tests {
                 centroid_deg: cen,
                 lambda2: if cen.is_some() { 30.0 } else { 0.0 },
                 axes: None,
+                swing_twist: None,
             });
         }
         check_gradient(JointLimits {
@@ -856,12 +871,14 @@ mod tests {
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         });
         check_gradient(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
             axes: None,
+            swing_twist: None,
         });
     }
 
@@ -1005,6 +1022,7 @@ mod tests {
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         };
         let cost = WindowCost::new(&measured, &limits, 0.05);
         assert_eq!(cost.eval(&Quat::identity()), 0.0);

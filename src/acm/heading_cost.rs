@@ -232,12 +232,14 @@ mod tests {
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
             axes: None,
+            swing_twist: None,
         };
         let knee = JointLimits {
             range_deg: [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         };
         // In every test axes (the segment frames', proper and mirrored ones).
         let all: Vec<JointLimits> = [shoulder, knee]
@@ -288,12 +290,14 @@ mod tests {
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         };
         let shoulder = JointLimits {
             range_deg: [[-10.0, 100.0], [-40.0, 60.0], [-70.0, 70.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
             axes: None,
+            swing_twist: None,
         };
         check(knee, Vertical::ZUp);
         check(shoulder, Vertical::ZUp);

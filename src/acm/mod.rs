@@ -17,6 +17,7 @@ pub mod hinge;
 pub mod lookahead;
 pub mod minimise;
 pub mod parent_cost;
+mod swing_cost;
 /// The window layout, shared with the baselines (a leaf: [`crate::window`]).
 pub use crate::window;
 

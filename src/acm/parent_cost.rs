@@ -223,12 +223,14 @@ mod tests {
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         });
         check(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
             axes: None,
+            swing_twist: None,
         });
     }
 
@@ -275,18 +277,21 @@ mod tests {
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         });
         check_gradient(JointLimits {
             range_deg: [[-45.0, 160.0], [-60.0, 60.0], [-170.0, 90.0]],
             centroid_deg: Some([47.0, -1.0, -31.0]),
             lambda2: 30.0,
             axes: None,
+            swing_twist: None,
         });
         check_gradient(JointLimits {
             range_deg: [[-180.0, 180.0], [-10.0, 30.0], [-180.0, 180.0]],
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         });
     }
 }

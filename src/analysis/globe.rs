@@ -468,6 +468,55 @@ pub fn globe_raster(
     out
 }
 
+/// The edge of a swing-twist region ([`crate::limits::swing_twist`]) on the
+/// sphere: the directions of the twist axis (the segment's long axis) turned
+/// by the swings on the region's edge, `per` points (closed: the first
+/// repeated last). Unit vectors in the table's axes, as [`direction`]'s; for
+/// a twist about X they are the segment's true directions, like the points.
+pub fn swing_outline(
+    st: &crate::limits::swing_twist::SwingTwistLimits,
+    per: usize,
+) -> Vec<[f64; 3]> {
+    let per = per.max(4);
+    let [a1, a2] = crate::limits::swing_twist::swing_axes(st.twist_axis);
+    let [h1, h2] = st.half_deg;
+    (0..=per)
+        .map(|k| {
+            let th = k as f64 * std::f64::consts::TAU / per as f64;
+            let (s, c) = th.sin_cos();
+            let (u, v) = match st.corner_deg {
+                None => (h1 * c, h2 * s),
+                // Along the ray from the centre at angle th, the edge of the
+                // (convex) rounded box, by bisection.
+                Some(r) => {
+                    let inside = |t: f64| {
+                        let qu = ((t * c).abs() - (h1 - r)).max(0.0);
+                        let qv = ((t * s).abs() - (h2 - r)).max(0.0);
+                        (qu * qu + qv * qv).sqrt() <= r
+                    };
+                    let (mut lo, mut hi) = (0.0, h1 + h2);
+                    for _ in 0..60 {
+                        let mid = 0.5 * (lo + hi);
+                        if inside(mid) {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    (lo * c, lo * s)
+                }
+            };
+            let mut rv = nalgebra::Vector3::zeros();
+            rv[a1] = (st.centre_deg[0] + u).to_radians();
+            rv[a2] = (st.centre_deg[1] + v).to_radians();
+            let mut e = nalgebra::Vector3::zeros();
+            e[st.twist_axis] = 1.0;
+            let d = crate::rotation::Quat::from_scaled_axis(rv) * e;
+            [d[0], d[1], d[2]]
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -702,5 +751,47 @@ mod tests {
             globe_raster(&back, &KNEE, axes, &view, Colouring::Limits, grid(50)).count(),
             0
         );
+    }
+
+    #[test]
+    fn swing_outline_is_the_region_edge_turning_the_twist_axis() {
+        use crate::limits::swing_twist::SwingTwistLimits;
+        // A 30-deg cone about Z: every direction 30 deg from Z.
+        let cone = SwingTwistLimits {
+            twist_axis: 2,
+            centre_deg: [0.0, 0.0],
+            half_deg: [30.0, 30.0],
+            corner_deg: None,
+            twist_deg: [-5.0, 5.0],
+            edge_twist_deg: [-5.0, 5.0],
+        };
+        let out = swing_outline(&cone, 64);
+        assert_eq!(out.len(), 65);
+        for d in &out {
+            assert!((d[2].acos().to_degrees() - 30.0).abs() < 1e-9, "{d:?}");
+        }
+        // A knee-like box (flexion 0..80 about Y, +-5 about Z, twist about
+        // X): each direction is X turned about the swing's axis by its angle,
+        // and the swings lie on the box's edge.
+        let knee = SwingTwistLimits {
+            twist_axis: 0,
+            centre_deg: [40.0, 0.0],
+            half_deg: [40.0, 5.0],
+            corner_deg: Some(0.0),
+            ..cone
+        };
+        for d in swing_outline(&knee, 64) {
+            let angle = d[0].clamp(-1.0, 1.0).acos().to_degrees();
+            // x cross d = sin(angle) * (0, -s_z... ): the swing's axis (0, s_y, s_z)/|s|.
+            let (sy, sz) = (-d[2], d[1]);
+            let norm = (sy * sy + sz * sz).sqrt();
+            // (The edge passes through the zero swing, X itself.)
+            let k = if norm > 1e-12 { angle / norm } else { 0.0 };
+            let (sy, sz) = (sy * k, sz * k);
+            let on_edge = (sy.abs() < 1e-6 || (sy - 80.0).abs() < 1e-6 || sz.abs() > 5.0 - 1e-6)
+                && (-1e-6..=80.0 + 1e-6).contains(&sy)
+                && sz.abs() <= 5.0 + 1e-6;
+            assert!(on_edge, "({sy}, {sz})");
+        }
     }
 }

@@ -22,6 +22,7 @@ pub mod histogram;
 pub mod scatter;
 pub mod stick;
 pub mod suggest;
+pub mod suggest_swing;
 
 use crate::limits::LimitTable;
 use crate::model::Model;

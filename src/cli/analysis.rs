@@ -82,6 +82,10 @@ pub struct SuggestArgs {
     /// Print the diff only; write nothing.
     #[arg(long)]
     pub dry_run: bool,
+    /// Suggest a swing-twist table (docs/method.md section 5.1): from the
+    /// current table when it is one, else from the shipped swing_twist.csv.
+    #[arg(long)]
+    pub swing_twist: bool,
 }
 
 #[derive(Debug, Args)]
@@ -159,6 +163,9 @@ fn original_table(table: &TableArgs) -> anyhow::Result<PathBuf> {
 pub fn run_suggest(a: SuggestArgs) -> anyhow::Result<i32> {
     let span = a.span.span(TimeSpan::FIRST_30_S.end_s)?;
     let (ctx, trials) = load_trials(&a.table, &a.trials)?;
+    if a.swing_twist {
+        return run_suggest_swing_twist(&a, span, &ctx, &trials);
+    }
     let pooled = pooled(&ctx, &trials, span, false)?;
     let hists = histograms(&pooled, &ctx.limits, &ctx.model, DEFAULT_BIN_DEG);
     let s = suggest_limits(&ctx.limits, &hists, span, SuggestOptions::default());
@@ -167,6 +174,46 @@ pub fn run_suggest(a: SuggestArgs) -> anyhow::Result<i32> {
         trials.len(),
         span.label(),
         ctx.limits_source
+    )?;
+    for line in s.diff_lines() {
+        outln!("{line}")?;
+    }
+    if a.dry_run {
+        return Ok(super::EXIT_OK);
+    }
+    let original = original_table(&a.table)?;
+    write_table(&s.table, &a.out, Some(&original))?;
+    outln!("wrote {}", a.out.display())?;
+    Ok(super::EXIT_OK)
+}
+
+/// `acmw suggest-limits --swing-twist`: the swing-twist suggestion's diff,
+/// and the table written unless `--dry-run`.
+fn run_suggest_swing_twist(
+    a: &SuggestArgs,
+    span: TimeSpan,
+    ctx: &Context,
+    trials: &[Trial],
+) -> anyhow::Result<i32> {
+    use acm_workbench::analysis::suggest_swing::suggest_swing_twist;
+    let refs = trial_refs(trials, &ctx.model);
+    let s = suggest_swing_twist(&ctx.limits, &refs, span, SuggestOptions::default());
+    if s.rows.iter().all(|r| r.samples == 0) {
+        bail!(
+            "no joint of model '{}' has samples in {}",
+            ctx.model.name,
+            span.label()
+        );
+    }
+    outln!(
+        "Suggested swing-twist limits from {} trial(s), {} (90% of the samples around the mean); against {}:",
+        trials.len(),
+        span.label(),
+        if ctx.limits.swing_twist.is_some() {
+            ctx.limits_source.as_str()
+        } else {
+            "<built-in swing_twist.csv>"
+        }
     )?;
     for line in s.diff_lines() {
         outln!("{line}")?;

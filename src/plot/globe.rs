@@ -9,7 +9,8 @@
 use super::scatter::{caption, key_colours, POINT_PX};
 use super::{draw_err, Figure, PlotError, FONT};
 use crate::analysis::globe::{
-    band_outline, band_points, extent, globe_raster, grid_lines, rect_outline, GlobeView, JointAxes,
+    band_outline, band_points, extent, globe_raster, grid_lines, rect_outline, swing_outline,
+    GlobeView, JointAxes,
 };
 use crate::analysis::scatter::{Colouring, Grid};
 use crate::limits::axis_name;
@@ -20,6 +21,8 @@ use plotters::prelude::*;
 pub const BAND_RGB: RGBColor = RGBColor(0xff, 0xe0, 0x40);
 /// Grid lines and the sphere's outline.
 pub const GRID_RGB: RGBColor = RGBColor(0xc8, 0xc8, 0xc8);
+/// The edge of a swing-twist region.
+pub const SWING_RGB: RGBColor = RGBColor(0xd0, 0x60, 0x00);
 
 /// What a globographic figure shows.
 #[derive(Debug, Clone)]
@@ -36,6 +39,9 @@ pub struct Globe<'a> {
     pub range_deg: [[f64; 2]; 3],
     pub axes: JointAxes,
     pub colouring: Colouring,
+    /// The joint's swing-twist region, drawn as its edge over the band, when
+    /// the limit table is of that model.
+    pub swing: Option<crate::limits::swing_twist::SwingTwistLimits>,
 }
 
 /// Visible runs of a polyline on the view's screen.
@@ -156,6 +162,17 @@ impl Globe<'_> {
                 )
                 .map_err(draw_err)?,
         };
+        // A swing-twist table's region: its edge, over the band (its box).
+        if let Some(st) = &self.swing {
+            for run in runs(view, &swing_outline(st, 256)) {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        run,
+                        SWING_RGB.stroke_width(2),
+                    )))
+                    .map_err(draw_err)?;
+            }
+        }
         // The samples, one point per pixel, lower keys first.
         let (pw, ph) = chart.plotting_area().dim_in_pixel();
         let grid = Grid {
@@ -206,6 +223,7 @@ mod tests {
             range_deg: knee,
             axes: JointAxes::default(),
             colouring: Colouring::Limits,
+            swing: None,
         };
         let svg = to_svg(&fig, (900, 900)).unwrap();
         let fill = |c: RGBColor| format!("fill=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);

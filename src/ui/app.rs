@@ -268,6 +268,7 @@ pub fn update(app: &mut App, msg: Msg) -> Vec<Effect> {
                     app.limits.saved_table = LimitTable {
                         preamble: vec![],
                         rows: vec![],
+                        swing_twist: None,
                     };
                     app.error(format!("cannot save limits: {m}"));
                 }

@@ -458,6 +458,13 @@ impl LimitsState {
             settings.settings().validate("").map_err(|e| e.message)?;
             return Ok((table, settings));
         }
+        if table.swing_twist.is_some() {
+            // Its rows here are the boxes of its regions, not what it limits.
+            return Err(
+                "a swing-twist table is edited in its CSV file; the workbench edits Euler tables"
+                    .into(),
+            );
+        }
         let joint = table.rows[self.row].joint.clone();
         match self.col {
             2 => {

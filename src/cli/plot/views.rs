@@ -60,11 +60,11 @@ pub fn globe(a: &PlotArgs, ctx: &Context, trial: &Trial, size: (u32, u32)) -> an
         Some((l, v)) => Some((l.clone(), span_of(a, trial, v)?)),
         None => None,
     };
-    let range = ctx
+    let limits = ctx
         .limits
         .joint_limits(&s.joint.name, &s.joint.kind, false)
-        .ok_or_else(|| anyhow!("no limits for joint '{}'", s.joint.name))?
-        .range_deg;
+        .ok_or_else(|| anyhow!("no limits for joint '{}'", s.joint.name))?;
+    let range = limits.range_deg;
     let fig = Globe {
         title: format!(
             "{}  {} direction around {}",
@@ -76,6 +76,7 @@ pub fn globe(a: &PlotArgs, ctx: &Context, trial: &Trial, size: (u32, u32)) -> an
         range_deg: range,
         axes: JointAxes::of(&ctx.limits, &s.joint.name, &s.joint.kind),
         colouring: colouring(a),
+        swing: limits.swing_twist,
     };
     plot::write(&fig, &a.output, size)?;
     Ok(())
