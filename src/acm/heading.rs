@@ -585,7 +585,7 @@ const REFINED_MINIMA: usize = 3;
 /// number of coarse steps are scanned whole.
 fn refined_grid_minimum(eval: &mut impl FnMut(f64) -> f64, step: f64) -> Option<(f64, f64)> {
     let n = grid_points(step);
-    if n % REFINE_BY != 0 || n < 3 * REFINE_BY {
+    if !n.is_multiple_of(REFINE_BY) || n < 3 * REFINE_BY {
         return grid_minimum(eval, step);
     }
     let coarse: Vec<f64> = (0..n / REFINE_BY)
