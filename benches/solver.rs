@@ -13,7 +13,10 @@
 //!   2 h, as a multiple of the decoded orientations (samples x IMUs x 32 bytes).
 //!
 //! Run with `cargo bench --bench solver`. The ratios are printed at the end,
-//! from the mean time per iteration of criterion's own samples.
+//! from the mean time per iteration of criterion's own samples; with a
+//! filter (`cargo bench --bench solver -- 'Gradient drift-(heading-)?centroid 5'`)
+//! only the ratios of what ran. `SOLVER_BENCH_NO_MEMORY=1` leaves out the
+//! peak-heap figures (three more corrections, one of a 2-hour trial).
 
 use acm_workbench::acm::minimise::Solver;
 use acm_workbench::acm::{Correction, RunControl, Variant};
@@ -57,26 +60,50 @@ static ALLOC: Counting = Counting;
 /// Mean seconds per iteration of each benchmark, as measured.
 static MEANS: Mutex<BTreeMap<String, (f64, u64)>> = Mutex::new(BTreeMap::new());
 
+/// CPU seconds of every thread of this process so far (user and system).
+fn cpu_s() -> f64 {
+    // SAFETY: getrusage fills the struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    s(u.ru_utime) + s(u.ru_stime)
+}
+
+/// CPU seconds per iteration of each benchmark, as measured: less sensitive
+/// than wall time to other work on a shared machine.
+static CPU: Mutex<BTreeMap<String, (f64, u64)>> = Mutex::new(BTreeMap::new());
+
 /// Runs `f` under criterion and records its mean time per iteration.
 fn timed(b: &mut Bencher, name: &str, mut f: impl FnMut()) {
     b.iter_custom(|iters| {
-        let start = Instant::now();
+        let (start, cpu) = (Instant::now(), cpu_s());
         for _ in 0..iters {
             f();
         }
         let took = start.elapsed();
+        let used = cpu_s() - cpu;
         let mut means = MEANS.lock().unwrap();
         let e = means.entry(name.to_string()).or_insert((0.0, 0));
         e.0 += took.as_secs_f64();
+        e.1 += iters;
+        let mut cpu = CPU.lock().unwrap();
+        let e = cpu.entry(name.to_string()).or_insert((0.0, 0));
+        e.0 += used;
         e.1 += iters;
         took
     });
 }
 
-fn mean_s(name: &str) -> f64 {
+/// The mean CPU seconds per iteration of benchmark `name`, if it ran.
+fn cpu_mean_s(name: &str) -> Option<f64> {
+    let cpu = CPU.lock().unwrap();
+    cpu.get(name).map(|&(s, n)| s / n as f64)
+}
+
+/// The mean seconds per iteration of benchmark `name`, if it ran.
+fn mean_s(name: &str) -> Option<f64> {
     let means = MEANS.lock().unwrap();
-    let (s, n) = means[name];
-    s / n as f64
+    means.get(name).map(|&(s, n)| s / n as f64)
 }
 
 /// A 13-IMU, 50 Hz trial with random 5-30 deg misalignments and 0.3 deg noise.
@@ -141,17 +168,21 @@ fn benches(c: &mut Criterion) {
         .build_global()
         .expect("the global pool is built once");
     let five = trial(5.0);
-    let two_hours = trial(120.0);
+    // Simulated when first needed (the 2-hour bench, the peak-heap figures).
+    let two_hours = std::sync::OnceLock::new();
+    let two_hours = || two_hours.get_or_init(|| trial(120.0));
     let table = LimitTable::default_table();
     let edited = edited_table();
     let mut memory = Vec::new();
-    for (name, minutes) in [("5 min", 5.0), ("30 min", 30.0), ("2 h", 120.0)] {
-        let t = if minutes == 120.0 {
-            two_hours.clone()
-        } else {
-            trial(minutes)
-        };
-        memory.push((name, peak_memory_ratio(&t)));
+    if std::env::var_os("SOLVER_BENCH_NO_MEMORY").is_none() {
+        for (name, minutes) in [("5 min", 5.0), ("30 min", 30.0), ("2 h", 120.0)] {
+            let t = if minutes == 120.0 {
+                two_hours().clone()
+            } else {
+                trial(minutes)
+            };
+            memory.push((name, peak_memory_ratio(&t)));
+        }
     }
 
     let mut g = c.benchmark_group("solver");
@@ -190,13 +221,15 @@ fn benches(c: &mut Criterion) {
     }
     let name = "Gradient drift-centroid 2 h";
     g.bench_function(name, |b| {
+        let t = two_hours();
         timed(b, name, || {
-            run(&two_hours, Variant::DriftCentroid, &table, Solver::Gradient);
+            run(t, Variant::DriftCentroid, &table, Solver::Gradient);
         })
     });
     g.finish();
 
-    let ratio = |a: &str, b: &str| mean_s(a) / mean_s(b);
+    // Only what ran (a filter may leave benchmarks out).
+    let ratio = |a: &str, b: &str| Some(mean_s(a)? / mean_s(b)?);
     eprintln!("\n== solver ratios (mean seconds per run, 2 threads)");
     for what in [
         "drift-centroid 5 min",
@@ -204,26 +237,40 @@ fn benches(c: &mut Criterion) {
         "drift-heading-centroid 5 min",
     ] {
         let (nm, gr) = (format!("NelderMead {what}"), format!("Gradient {what}"));
-        eprintln!(
-            "{what}: Nelder-Mead {:.3} s, gradient {:.3} s: {:.2}x faster",
-            mean_s(&nm),
-            mean_s(&gr),
-            ratio(&nm, &gr)
-        );
+        if let (Some(a), Some(b), Some(r)) = (mean_s(&nm), mean_s(&gr), ratio(&nm, &gr)) {
+            eprintln!("{what}: Nelder-Mead {a:.3} s, gradient {b:.3} s: {r:.2}x faster");
+        }
     }
     for solver in ["Gradient", "NelderMead"] {
+        let heading = format!("{solver} drift-heading-centroid 5 min");
+        if let (Some(h), Some(c), Some(r)) = (
+            mean_s(&heading),
+            mean_s("Gradient drift-centroid 5 min"),
+            ratio(&heading, "Gradient drift-centroid 5 min"),
+        ) {
+            eprintln!(
+                "drift-heading-centroid ({solver} heading fit) / drift-centroid (gradient), 5 min: {h:.3} s / {c:.3} s = {r:.2}"
+            );
+        }
+        if let (Some(h), Some(c)) = (
+            cpu_mean_s(&heading),
+            cpu_mean_s("Gradient drift-centroid 5 min"),
+        ) {
+            eprintln!(
+                "  the same in CPU time (both threads): {h:.3} s / {c:.3} s = {:.2}",
+                h / c
+            );
+        }
+    }
+    if let (Some(long), Some(five)) = (
+        mean_s("Gradient drift-centroid 2 h"),
+        mean_s("Gradient drift-centroid 5 min"),
+    ) {
         eprintln!(
-            "drift-heading-centroid ({solver} heading fit) / drift-centroid (gradient), 5 min: {:.2}",
-            ratio(
-                &format!("{solver} drift-heading-centroid 5 min"),
-                "Gradient drift-centroid 5 min"
-            )
+            "2 h / (24 x 5 min) (drift-centroid, gradient): {:.2}",
+            long / (24.0 * five)
         );
     }
-    eprintln!(
-        "2 h / (24 x 5 min) (drift-centroid, gradient): {:.2}",
-        mean_s("Gradient drift-centroid 2 h") / (24.0 * mean_s("Gradient drift-centroid 5 min"))
-    );
     for (name, m) in memory {
         eprintln!("peak heap during drift-centroid, {name}: {m:.2} x the decoded orientations");
     }

@@ -124,10 +124,18 @@ pub fn read_to_end_capped(reader: impl Read, limit: u64, what: &str) -> io::Resu
 pub fn read_bytes(path: &Path) -> io::Result<Vec<u8>> {
     let limit = max_input_bytes();
     let file = open_regular(path)?;
-    if file.metadata()?.len() > limit {
+    let len = file.metadata()?.len();
+    if len > limit {
         return Err(too_large(limit, "file is"));
     }
-    read_to_end_capped(file, limit, "file is")
+    // Sized for the file as it is (one read, no regrowing); a file that grows
+    // meanwhile is still read to its end, up to the limit.
+    let mut out = Vec::with_capacity(usize::try_from(len).map_or(0, |n| n.saturating_add(1)));
+    file.take(limit.saturating_add(1)).read_to_end(&mut out)?;
+    if out.len() as u64 > limit {
+        return Err(too_large(limit, "file is"));
+    }
+    Ok(out)
 }
 
 /// The text of the regular file at `path` (UTF-8), at most [`max_input_bytes`].

@@ -165,9 +165,11 @@ pub fn trial_figures(
     model: &Model,
     limits: &LimitTable,
 ) -> Vec<JointFigures> {
+    use rayon::prelude::*;
+    // Each joint on its own, collected in the model's order.
     model
         .joints
-        .iter()
+        .par_iter()
         .filter_map(|joint| {
             let angles = joint_angles(trial, joint)?;
             let lim = limits.joint_limits(&joint.name, &joint.kind, false)?;

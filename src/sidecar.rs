@@ -369,20 +369,32 @@ impl SaveRequest<'_> {
     /// [`SaveRequest::sidecar`], perhaps amended), as [`SaveRequest::save`] does.
     /// The output and its sidecar are written under an [`OutputLock`]: a
     /// second run writing the same output waits, then refuses.
-    pub fn save_with(&self, mut sidecar: Sidecar) -> anyhow::Result<PathBuf> {
+    pub fn save_with(&self, sidecar: Sidecar) -> anyhow::Result<PathBuf> {
+        self.save_building(move || sidecar)
+    }
+
+    /// As [`SaveRequest::save_with`], the sidecar built by `build` while the
+    /// corrected trial is formatted and written (the same files as building
+    /// it first).
+    pub fn save_building(&self, build: impl FnOnce() -> Sidecar + Send) -> anyhow::Result<PathBuf> {
         if let Some(dir) = self.output.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| anyhow::anyhow!("{}: cannot create folder: {e}", dir.display()))?;
         }
         let _lock = OutputLock::acquire(self.output)
             .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", self.output.display()))?;
-        let written = write_trial_hashed(
-            &self.correction.corrected,
-            self.output,
-            self.output_format,
-            self.correction.settings.precision,
-        )?;
-        sidecar.output_sha256 = Some(written);
+        let (written, mut sidecar) = rayon::join(
+            || {
+                write_trial_hashed(
+                    &self.correction.corrected,
+                    self.output,
+                    self.output_format,
+                    self.correction.settings.precision,
+                )
+            },
+            build,
+        );
+        sidecar.output_sha256 = Some(written?);
         if let Some(run) = &self.correction.ik {
             write_coordinates(run, &coordinates_path(self.output))?;
         }

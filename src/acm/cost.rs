@@ -921,6 +921,7 @@ mod tests {
             centroid_deg: centroid.map(|c| c.map(|v| if flip { -v } else { v })),
             lambda2: if centroid.is_some() { 30.0 } else { 0.0 },
             axes,
+            swing_twist: None,
         }
     }
 
@@ -986,6 +987,7 @@ mod tests {
             centroid_deg: None,
             lambda2: 0.0,
             axes: None,
+            swing_twist: None,
         };
         let cost = WindowCost::new(&flexed, &limits, 0.05);
         assert_eq!(cost.eval(&Quat::identity()), 0.0);

@@ -403,7 +403,9 @@ pub fn save_trial(
         output_format: output.format,
         sidecar: output.sidecar.as_deref(),
     };
-    let mut sidecar = request.sidecar();
-    sidecar.calibration = calibration.cloned();
-    request.save_with(sidecar)
+    request.save_building(|| {
+        let mut sidecar = request.sidecar();
+        sidecar.calibration = calibration.cloned();
+        sidecar
+    })
 }

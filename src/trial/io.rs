@@ -497,8 +497,12 @@ pub fn write_trial_hashed(
     } else {
         text.into_bytes()
     };
-    let sha256 = crate::input::sha256_hex(&bytes);
-    crate::save::atomic_write(path, &bytes).map_err(|e| crate::save::WriteError::io(path, &e))?;
+    // Hashed on one worker while the other writes (and flushes) the file.
+    let (sha256, written) = rayon::join(
+        || crate::input::sha256_hex(&bytes),
+        || crate::save::atomic_write(path, &bytes),
+    );
+    written.map_err(|e| crate::save::WriteError::io(path, &e))?;
     Ok(sha256)
 }
 
@@ -513,6 +517,36 @@ fn push_cells(out: &mut String, first: char, sep: char, values: &[f64], style: O
             None => push_f64(out, v),
         }
     }
+}
+
+/// Rows formatted in one part: the parts are the same at any thread count.
+const ROWS_PER_PART: usize = 1024;
+
+/// Appends rows `0..n` to `out`, each written by `row`: parts of
+/// [`ROWS_PER_PART`] rows formatted in parallel, appended in order (the
+/// same text as one pass). `per_row`: the bytes a row is expected to take.
+fn rows_in_parts(
+    out: &mut String,
+    n: usize,
+    per_row: usize,
+    row: impl Fn(&mut String, usize) + Sync,
+) {
+    use rayon::prelude::*;
+    if n <= ROWS_PER_PART {
+        (0..n).for_each(|i| row(out, i));
+        return;
+    }
+    let parts: Vec<String> = (0..n.div_ceil(ROWS_PER_PART))
+        .into_par_iter()
+        .map(|p| {
+            let rows = p * ROWS_PER_PART..((p + 1) * ROWS_PER_PART).min(n);
+            let mut part = String::with_capacity(rows.len() * per_row);
+            rows.for_each(|i| row(&mut part, i));
+            part
+        })
+        .collect();
+    out.reserve(parts.iter().map(String::len).sum());
+    parts.iter().for_each(|p| out.push_str(p));
 }
 
 /// The text of a trial in `format` (uncompressed), orientation numbers with
@@ -561,23 +595,23 @@ pub fn trial_to_string_at(trial: &Trial, format: TrialFormat, precision: Precisi
                 }
             }
             out.push('\n');
-            for i in 0..n {
-                push_f64(&mut out, trial.time_s[i]);
+            rows_in_parts(&mut out, n, per_row, |out, i| {
+                push_f64(out, trial.time_s[i]);
                 for s in &trial.imus {
                     let q = &s.orientation[i];
                     if format == TrialFormat::QuatCsv {
                         let q = canonical(q);
-                        push_cells(&mut out, ',', ',', &[q.w, q.i, q.j, q.k], style);
+                        push_cells(out, ',', ',', &[q.w, q.i, q.j, q.k], style);
                     } else {
-                        push_cells(&mut out, ',', ',', &euler_zyx_deg(q), style);
+                        push_cells(out, ',', ',', &euler_zyx_deg(q), style);
                     }
                     if let Some(g) = &s.gyro {
                         let w = &g[i];
-                        push_cells(&mut out, ',', ',', &[w.x, w.y, w.z], None);
+                        push_cells(out, ',', ',', &[w.x, w.y, w.z], None);
                     }
                 }
                 out.push('\n');
-            }
+            });
         }
         TrialFormat::Sto | TrialFormat::Xsens => {
             let _ = write!(
@@ -589,14 +623,14 @@ pub fn trial_to_string_at(trial: &Trial, format: TrialFormat, precision: Precisi
                 let _ = write!(out, "\t{}", s.name);
             }
             out.push('\n');
-            for i in 0..n {
-                push_f64(&mut out, trial.time_s[i]);
+            rows_in_parts(&mut out, n, per_row, |out, i| {
+                push_f64(out, trial.time_s[i]);
                 for s in &trial.imus {
                     let q = canonical(&s.orientation[i]);
-                    push_cells(&mut out, '\t', ',', &[q.w, q.i, q.j, q.k], style);
+                    push_cells(out, '\t', ',', &[q.w, q.i, q.j, q.k], style);
                 }
                 out.push('\n');
-            }
+            });
         }
     }
     out

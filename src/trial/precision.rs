@@ -163,6 +163,19 @@ impl Tally {
         }
     }
 
+    /// Adds what `other` saw (the counts of another part of the same file).
+    pub(crate) fn merge(&mut self, other: Tally) {
+        if !other.seen {
+            return;
+        }
+        if self.seen {
+            self.most = self.most.max(other.most);
+            self.fewest = self.fewest.min(other.fewest);
+        } else {
+            *self = other;
+        }
+    }
+
     /// The record of what was seen: `None` when nothing was, or some number
     /// had [`FULL_FROM`] or more places (full precision).
     pub(crate) fn finish(self, numbers: AngleNumbers) -> Option<Decimals> {

@@ -778,6 +778,11 @@ pub(crate) fn parse_trial(
 /// the header (its line numbers are the file's). `check_axis`: check the
 /// times as a whole trial's ([`crate::trial::timing::check_time_axis`]);
 /// without it the rows are only checked to increase.
+///
+/// Rows of a large text are parsed in parallel parts cut at line ends (the
+/// same parts at any thread count) and joined in order; when any part fails,
+/// or the times do not increase across a cut, the rows are read again in
+/// one pass, which reports the first error in the file as it always has.
 pub(crate) fn parse_rows(
     mut lines: LineIter<'_>,
     layout: Layout,
@@ -791,7 +796,118 @@ pub(crate) fn parse_rows(
     } else {
         AngleNumbers::Quaternion
     };
+    if lines.rest.is_some_and(|r| r.len() >= PARALLEL_FROM_BYTES) {
+        if let Some((acc, end)) = parse_parts(&lines, &layout, origin, format, numbers) {
+            return acc.finish(name, layout, end + 1, check_axis);
+        }
+    }
     let mut acc = Acc::new(origin, layout.imus.len(), numbers);
+    rows_into(&mut acc, &mut lines, &layout, origin, format)?;
+    let end = lines.line_no() + 1;
+    acc.finish(name, layout, end, check_axis)
+}
+
+/// Texts of data rows at least this long are parsed in parallel parts.
+const PARALLEL_FROM_BYTES: usize = 1 << 20;
+/// The length a part aims at (it ends at the first line end after it).
+pub(crate) const PART_BYTES: usize = 1 << 18;
+
+/// The rows after the header in `lines`, parsed in parts of about
+/// [`PART_BYTES`] in parallel and joined in order, with the number of the
+/// text's last line; `None` when a part fails or times do not increase
+/// across a cut (the caller then reads the rows in one pass).
+fn parse_parts<'a>(
+    lines: &LineIter<'_>,
+    layout: &Layout,
+    origin: &'a str,
+    format: TrialFormat,
+    numbers: AngleNumbers,
+) -> Option<(Acc<'a>, u64)> {
+    use rayon::prelude::*;
+    let text = lines.rest?;
+    let bytes = text.as_bytes();
+    let mut cuts = vec![0];
+    let mut at = 0;
+    while at + PART_BYTES < bytes.len() {
+        let Some(nl) = bytes[at + PART_BYTES..].iter().position(|&b| b == b'\n') else {
+            break;
+        };
+        at += PART_BYTES + nl + 1;
+        cuts.push(at);
+    }
+    cuts.push(bytes.len());
+    // A cut is after a newline, an ASCII byte: always a character boundary.
+    let parts: Vec<&str> = cuts.windows(2).map(|w| &text[w[0]..w[1]]).collect();
+    let newlines: Vec<u64> = parts
+        .par_iter()
+        .map(|p| p.bytes().filter(|&b| b == b'\n').count() as u64)
+        .collect();
+    let mut first = Vec::with_capacity(parts.len());
+    let mut line = lines.line_no() + 1;
+    for n in &newlines {
+        first.push(line);
+        line += n;
+    }
+    let parsed: Vec<Option<(Acc, u64)>> = parts
+        .par_iter()
+        .zip(first)
+        .map(|(&part, first)| {
+            let mut acc = Acc::new(origin, layout.imus.len(), numbers);
+            let mut it = LineIter::starting_at(part, first);
+            rows_into(&mut acc, &mut it, layout, origin, format).ok()?;
+            Some((acc, it.line_no()))
+        })
+        .collect();
+    let parsed: Vec<(Acc, u64)> = parsed.into_iter().collect::<Option<_>>()?;
+    let end = parsed.last().map_or(lines.line_no(), |(_, e)| *e);
+    let rows: usize = parsed.iter().map(|(a, _)| a.time.len()).sum();
+    let mut all = Acc::new(origin, layout.imus.len(), numbers);
+    all.time.reserve_exact(rows);
+    all.lines.reserve_exact(rows);
+    for (k, s) in all.series.iter_mut().enumerate() {
+        s.reserve_exact(rows);
+        if layout.imus[k].gyro.is_some() {
+            all.gyro[k].reserve_exact(rows);
+        }
+    }
+    for (part, _) in parsed {
+        if let (Some(&prev), Some(&t)) = (all.time.last(), part.time.first()) {
+            if t <= prev {
+                return None;
+            }
+        }
+        all.time.extend_from_slice(&part.time);
+        all.lines.extend_from_slice(&part.lines);
+        if !part.time.is_empty() {
+            all.last_line = part.last_line;
+        }
+        for (a, p) in all.series.iter_mut().zip(&part.series) {
+            a.extend_from_slice(p);
+        }
+        for (a, p) in all.gyro.iter_mut().zip(&part.gyro) {
+            a.extend_from_slice(p);
+        }
+        for (a, p) in all.renorm.iter_mut().zip(&part.renorm) {
+            a.count += p.count;
+            // As one pass keeps it: the first of the worst.
+            if p.worst_off > a.worst_off {
+                (a.worst_off, a.worst_norm, a.worst_line) =
+                    (p.worst_off, p.worst_norm, p.worst_line);
+            }
+        }
+        all.tally.merge(part.tally);
+    }
+    Some((all, end))
+}
+
+/// Reads the data rows of `lines` into `acc`, stopping at the first error.
+fn rows_into(
+    acc: &mut Acc<'_>,
+    lines: &mut LineIter<'_>,
+    layout: &Layout,
+    origin: &str,
+    format: TrialFormat,
+) -> Result<(), TrialError> {
     let ncols = layout.columns.len();
     match format {
         TrialFormat::QuatCsv | TrialFormat::EulerCsv => {
@@ -871,6 +987,5 @@ pub(crate) fn parse_rows(
             }
         }
     }
-    let end = lines.line_no() + 1;
-    acc.finish(name, layout, end, check_axis)
+    Ok(())
 }

@@ -742,3 +742,105 @@ fn trial_large_csv_reads_back() {
     assert_eq!(back.len(), 15_000);
     assert_eq!(back.time_s, trial.time_s);
 }
+
+/// A text of 20,000 rows of four IMUs (about 2 MB, read in parallel parts)
+/// with its rows as lines: `lines[0]` is the header.
+fn large_text() -> (Trial, Vec<String>) {
+    let trial = random_trial(&NAMES, 20_000, 9);
+    let text = trial_to_string(&trial, Q);
+    assert!(text.len() > 2 * (1 << 20), "{}", text.len());
+    (trial, text.lines().map(str::to_string).collect())
+}
+
+fn joined(lines: &[String]) -> String {
+    let mut t = lines.join("\n");
+    t.push('\n');
+    t
+}
+
+#[test]
+fn trial_large_text_reads_in_parts_as_in_one_pass() {
+    let (trial, mut lines) = large_text();
+    // Off unit norm on rows in different parts: the worst, seen twice, is
+    // reported on its first line (file lines are row + 1).
+    for (row, w) in [(3_000, "1.003"), (17_000, "1.008"), (18_500, "1.008")] {
+        let mut cells: Vec<String> = lines[row].split(',').map(str::to_string).collect();
+        cells[1] = w.to_string();
+        for c in &mut cells[2..5] {
+            *c = "0".to_string();
+        }
+        lines[row] = cells.join(",");
+    }
+    // Blank lines and CRLF endings anywhere are as in one pass.
+    lines[9_000].push('\r');
+    lines.insert(12_000, String::new());
+    let text = joined(&lines);
+    let back = read_trial_from_str(&text, "big.csv", Q, &infant()).unwrap();
+    assert_eq!(back.len(), 20_000);
+    assert_eq!(back.time_s, trial.time_s);
+    assert_eq!(back.orientation_decimals, None);
+    assert_eq!(back.warnings.len(), 1, "{:?}", back.warnings);
+    let w = &back.warnings[0];
+    assert!(
+        w.starts_with("base:")
+            && w.contains("renormalised 3 of 20000")
+            // 17,001, moved down by the blank line
+            && w.contains("worst norm 1.008 on line 17002"),
+        "{w}"
+    );
+    let q = &back.imus[0].orientation;
+    assert_eq!(
+        q[16_999].into_inner(),
+        nalgebra::Quaternion::new(1.0, 0.0, 0.0, 0.0)
+    );
+    // Rows with fixed decimals: the decimals of every part.
+    let fixed = trial_to_string_at(&back, Q, Precision::Decimals(6));
+    let again = read_trial_from_str(&fixed, "big.csv", Q, &infant()).unwrap();
+    let d = again.orientation_decimals.expect("decimals read");
+    assert_eq!((d.fewest, d.most), (0, 6));
+}
+
+#[test]
+fn trial_large_text_errors_are_the_first_in_the_file() {
+    let (_, lines) = large_text();
+    let bad = |edits: &[(usize, &str)]| {
+        let mut l = lines.clone();
+        for &(row, cell) in edits {
+            let mut cells: Vec<&str> = l[row].split(',').collect();
+            cells[2] = cell;
+            l[row] = cells.join(",");
+        }
+        let e = read_trial_from_str(&joined(&l), "big.csv", Q, &infant()).unwrap_err();
+        (e.line, e.column, e.message)
+    };
+    let (line, column, message) = bad(&[(19_000, "x")]);
+    assert_eq!((line, column), (19_001, 3), "{message}");
+    assert!(
+        message.contains("expected a number for base_qx, found 'x'"),
+        "{message}"
+    );
+    // Of two bad rows in different parts, the earlier is reported.
+    let (line, _, message) = bad(&[(19_000, "x"), (2_500, "nan")]);
+    assert_eq!(line, 2_501, "{message}");
+    assert!(message.contains("expected a finite number"), "{message}");
+    // A time repeated on the first row of a part, across the cut.
+    let body = joined(&lines[1..]);
+    let cut = super::parse::PART_BYTES
+        + body.as_bytes()[super::parse::PART_BYTES..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .unwrap()
+        + 1;
+    let row = body[..cut].lines().count() + 1;
+    let mut l = lines.clone();
+    let prev_time = l[row - 1].split(',').next().unwrap().to_string();
+    let rest: Vec<&str> = l[row].split(',').skip(1).collect();
+    l[row] = format!("{prev_time},{}", rest.join(","));
+    let e = read_trial_from_str(&joined(&l), "big.csv", Q, &infant()).unwrap_err();
+    assert_eq!((e.line, e.column), (row as u64 + 1, 1), "{e}");
+    assert!(
+        e.message
+            .contains(&format!("repeated time {prev_time} (also on line {row})")),
+        "{e}"
+    );
+}
