@@ -139,8 +139,16 @@ pub fn read_bytes(path: &Path) -> io::Result<Vec<u8>> {
 }
 
 /// The text of the regular file at `path` (UTF-8), at most [`max_input_bytes`].
+/// An invalid byte's error says its line and column (as
+/// [`read_text_located`] finds them) in its message.
 pub fn read_text(path: &Path) -> io::Result<String> {
-    read_text_located(path).map_err(|e| e.error)
+    read_text_located(path).map_err(|e| match e.line {
+        0 => e.error,
+        line => io::Error::new(
+            e.error.kind(),
+            format!("line {line}, column {}: {}", e.column, e.error),
+        ),
+    })
 }
 
 /// Why a file could not be read as text, and where: line and column (1-based,
@@ -259,5 +267,17 @@ mod tests {
         std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
         let e = read_bytes(&link).unwrap_err();
         assert!(e.to_string().contains("a device"), "{e}");
+    }
+
+    #[test]
+    fn read_text_says_where_the_text_stops_being_utf8() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.json");
+        std::fs::write(&path, b"{\n  \"a\": \"x\xff\"\n}\n").unwrap();
+        let e = read_text(&path).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "line 2, column 10: expected UTF-8 text, found invalid byte 0xff"
+        );
     }
 }

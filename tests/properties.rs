@@ -639,8 +639,9 @@ fn the_seeds_are_valid() {
 }
 
 /// What the properties found, kept as fixed cases: a table name with a
-/// control character (written with Rust's `\u{1b}` escape, not TOML's), and a
-/// 17-digit float that serde_json's default parser read one ulp off.
+/// control character (written with Rust's `\u{1b}` escape, not TOML's), a
+/// 17-digit float that serde_json's default parser read one ulp off, and
+/// invalid UTF-8 after `//` (read as an export, its error was not located).
 #[test]
 fn regressions_found_by_the_properties() {
     let s = SettingsFile {
@@ -653,4 +654,8 @@ fn regressions_found_by_the_properties() {
         .insert("base".into(), [0.44317299437524277, 1e-6, -0.0]);
     let back: Model = serde_json::from_str(&serde_json::to_string_pretty(&m).unwrap()).unwrap();
     assert_eq!(back, m);
+    // Bytes that begin like an MT Manager export (`//`) and are not UTF-8:
+    // the export reader's error is located too.
+    let dir = tempfile::tempdir().unwrap();
+    read_any("t.csv", b"//\x80", dir.path()).unwrap();
 }

@@ -350,7 +350,7 @@ pub(crate) fn trial_of_exports(
     for ((f, name), bytes) in source.files.iter().zip(exports) {
         let origin = f.display().to_string();
         let text = crate::input::str_of(bytes)
-            .map_err(|e| TrialError::file(&origin, format!("cannot read: {}", e.error)))?;
+            .map_err(|e| TrialError::at(&origin, e.line, e.column, e.error.to_string()))?;
         parsed.push((name.clone(), parse_export(text, &origin)?));
     }
     assemble(&trial_name(path), parsed, rotation_of(source), model)
