@@ -197,6 +197,26 @@ pub struct SettingsFile {
     /// degrees, is flagged as a glitch (reported and shown, never smoothed).
     #[serde(default = "default_glitch_deg")]
     pub glitch_deg: f64,
+    /// Decimals of the orientation numbers written: `auto` (as read), `full`
+    /// or a count (`--precision` overrides it).
+    #[serde(default, deserialize_with = "precision_in_toml")]
+    pub precision: Precision,
+}
+
+/// `precision = "auto" | "full" | N` in the settings file, the count also
+/// as a bare integer (`precision = 6`).
+fn precision_in_toml<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Precision, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Written {
+        Count(i64),
+        Word(String),
+    }
+    let text = match Written::deserialize(d)? {
+        Written::Count(n) => n.to_string(),
+        Written::Word(w) => w,
+    };
+    Precision::parse(&text).map_err(serde::de::Error::custom)
 }
 
 fn default_glitch_deg() -> f64 {
@@ -244,17 +264,17 @@ impl SettingsFile {
             hop_s: self.hop_s,
             vertical: self.vertical,
             solver: Solver::default(),
-            precision: Precision::Auto,
+            precision: self.precision,
         }
     }
 
     /// TOML text for saving.
     pub fn to_toml(&self) -> String {
         format!(
-            "# Correction settings (docs/method.md sections 4-7); the limit table is a CSV in this folder.\ntable = {}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n",
+            "# Correction settings (docs/method.md sections 4-7); the limit table is a CSV in this folder.\ntable = {}\n# weight of the correction's rotation angle in the cost, per degree\nlambda1 = {}\n# drift windows: length and hop, seconds\nwindow_s = {}\nhop_s = {}\n# the global frame's up axis: z-up, or z-down for north-east-down recordings\nvertical = \"{}\"\n# an orientation jump between neighbouring samples beyond this, degrees, is flagged as a glitch\nglitch_deg = {}\n# decimals of the orientation numbers written: auto (as the input had them), full, or a count\nprecision = \"{}\"\n",
             // A TOML string (Rust's `{:?}` escapes control characters as `\u{1b}`, not TOML).
             toml::Value::String(self.table.clone()),
-            self.lambda1, self.window_s, self.hop_s, self.vertical.name(), self.glitch_deg
+            self.lambda1, self.window_s, self.hop_s, self.vertical.name(), self.glitch_deg, self.precision
         )
     }
 }
@@ -1102,5 +1122,32 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.message.contains("hop_s"), "{e}");
+    }
+
+    /// `precision` in the settings file: a word or a count (quoted or bare),
+    /// carried into the settings; a bad value is located on its line.
+    #[test]
+    fn settings_precision_key() {
+        let base = "table = \"t.csv\"\nlambda1 = 0.05\nwindow_s = 60.0\nhop_s = 30.0\n";
+        for (value, want) in [
+            ("\"full\"", Precision::Full),
+            ("\"auto\"", Precision::Auto),
+            ("6", Precision::Decimals(6)),
+            ("\"4\"", Precision::Decimals(4)),
+        ] {
+            let s = SettingsFile::parse(&format!("{base}precision = {value}\n"), "s.toml").unwrap();
+            assert_eq!(s.settings().precision, want, "{value}");
+            let back = SettingsFile::parse(&s.to_toml(), "s.toml").unwrap();
+            assert_eq!(back, s, "{value}");
+        }
+        assert_eq!(
+            SettingsFile::parse(base, "s.toml").unwrap().precision,
+            Precision::Auto
+        );
+        for bad in ["\"some\"", "18", "-1", "2.5"] {
+            let e =
+                SettingsFile::parse(&format!("{base}precision = {bad}\n"), "s.toml").unwrap_err();
+            assert_eq!(e.line, 5, "{bad}: {e}");
+        }
     }
 }

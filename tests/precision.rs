@@ -313,6 +313,30 @@ fn precision_n_and_from_sidecar_reproduce_the_bytes() {
         ],
     );
     assert!(std::fs::read_to_string(dir.path().join("replay.csv")).unwrap() == three);
+    // The same precision from the lab's settings file, the flag overriding it.
+    let limits = dir.path().join("joint_limits");
+    std::fs::create_dir(&limits).unwrap();
+    let settings =
+        acm_workbench::limits::BUILTIN_SETTINGS.replace("precision = \"auto\"", "precision = 3");
+    assert!(settings.contains("precision = 3"));
+    std::fs::write(limits.join("settings.toml"), settings).unwrap();
+    let from_settings = correct(dir.path(), "in.csv", "drift-centroid", "set.csv", &[]);
+    assert!(from_settings == three);
+    let sidecar = std::fs::read_to_string(dir.path().join("set.csv.acmw.json")).unwrap();
+    assert!(sidecar.contains("\"precision\": \"3\""), "{sidecar}");
+    let overridden = correct(
+        dir.path(),
+        "in.csv",
+        "drift-centroid",
+        "full.csv",
+        &["--precision", "full"],
+    );
+    assert!(overridden != three);
+    assert!(overridden
+        .lines()
+        .skip(1)
+        .flat_map(|l| l.split(',').skip(1).map(decimals_of).collect::<Vec<_>>())
+        .any(|d| d > 6));
     let bad = common::acmw(dir.path(), &["correct", "in.csv", "--precision", "18"]);
     assert!(!bad.status.success());
     let message = String::from_utf8_lossy(&bad.stderr);

@@ -22,6 +22,7 @@ use acm_workbench::limits::{LimitRow, LimitTable, SettingsFile};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::{angle_between_deg, quat_from_euler_zyx_deg};
 use acm_workbench::trial::mapping::parse_mapping;
+use acm_workbench::trial::precision::Precision;
 use acm_workbench::trial::xsens::parse_export;
 use acm_workbench::trial::{
     read_trial, read_trial_from_str, write_trial, ImuSeries, Trial, TrialFormat,
@@ -231,6 +232,7 @@ prop_compose! {
         hop_fraction in prop_oneof![Just(1e-3), Just(1.0), 1e-3..=1.0f64],
         z_down in any::<bool>(),
         glitch_deg in prop_oneof![Just(180.0), Just(1e-9), 1e-9..=180.0f64],
+        precision in prop_oneof![Just(Precision::Auto), Just(Precision::Full), (0u8..=17).prop_map(Precision::Decimals)],
     ) -> SettingsFile {
         SettingsFile {
             table,
@@ -240,6 +242,7 @@ prop_compose! {
             hop_s: (window_s * hop_fraction).clamp(window_s / 1000.0, window_s),
             vertical: if z_down { Vertical::ZDown } else { Vertical::ZUp },
             glitch_deg,
+            precision,
         }
     }
 }

@@ -5,6 +5,7 @@
 use acm_workbench::limits::{LimitRow, LimitTable, SettingsFile};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::{angle_between_deg, quat_from_euler_zyx_deg};
+use acm_workbench::trial::precision::Precision;
 use acm_workbench::trial::{read_trial, write_trial, ImuSeries, Trial, TrialFormat};
 use acm_workbench::vertical::Vertical;
 use nalgebra::Vector3;
@@ -138,6 +139,8 @@ fn written_limit_tables_and_settings_read_back() {
                 Vertical::ZDown
             },
             glitch_deg: rng.random_range(0.01..180.0),
+            precision: [Precision::Auto, Precision::Full, Precision::Decimals(6)]
+                [rng.random_range(0..3)],
         };
         let back = SettingsFile::parse(&s.to_toml(), "s.toml")
             .unwrap_or_else(|e| panic!("case {case}: {e}"));
