@@ -637,7 +637,17 @@ fn settings_cases() -> Vec<Case> {
         with(
             "glitch 500",
             format!("{s}  glitch_deg = 500\n").replace("glitch_deg = 30\n", ""),
-            Expect::Exact("acmw: joint_limits/settings.toml:11:3: glitch_deg: expected a number of degrees in (0, 180], found 500"),
+            Expect::Exact("acmw: joint_limits/settings.toml:13:3: glitch_deg: expected a number of degrees in (0, 180], found 500"),
+        ),
+        with(
+            "precision 18",
+            set("precision", "18"),
+            Expect::Located("settings.toml"),
+        ),
+        with(
+            "precision word",
+            set("precision", "\"most\""),
+            Expect::Located("settings.toml"),
         ),
         with(
             "table missing",
