@@ -118,6 +118,16 @@ impl JointLimits {
         }
     }
 
+    /// Whether these limits read the joint rotation `r` (segment frames) in
+    /// two Z-Y-X triplets (a Y range beyond +-90 deg) and its middle angle
+    /// lies within [`TWO_READINGS_ZONE_DEG`] of +-90: there the ACM cost has
+    /// one basin per reading (docs/method.md section 2.5).
+    pub fn near_the_other_triplet(&self, r: &crate::rotation::Quat) -> bool {
+        crate::rotation::y_beyond_90(&self.range_deg)
+            && crate::rotation::euler_zyx_deg(&self.to_axes(r))[1].abs()
+                >= 90.0 - TWO_READINGS_ZONE_DEG
+    }
+
     /// A joint rotation `r` (segment frames) as the ranges see it: `Q^T R Q`,
     /// or `r` itself without `axes`.
     pub fn to_axes(&self, r: &crate::rotation::Quat) -> crate::rotation::Quat {
@@ -144,6 +154,11 @@ pub struct LimitTable {
 /// A limit table or settings problem, located in its file (line 0 when the
 /// file as a whole is meant; column = field index).
 pub type LimitsError = crate::located::LocatedError;
+
+/// Half-width of the zone about a middle Z-Y-X angle of +-90 deg where a
+/// joint read in two triplets has one cost basin per reading
+/// ([`JointLimits::near_the_other_triplet`]), degrees.
+pub const TWO_READINGS_ZONE_DEG: f64 = 15.0;
 
 /// Settings of a correction that are not per joint.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -484,28 +499,9 @@ impl LimitTable {
             return parse_swing_twist(text, rdr, &found, &err);
         }
         if found != HEADER {
-            // The first field that differs (1-based), or the first one missing.
-            let column = found
-                .iter()
-                .zip(HEADER)
-                .position(|(f, h)| *f != h)
-                .unwrap_or(found.len().min(HEADER.len()))
-                + 1;
-            return Err(err(
-                1,
-                column,
-                format!(
-                    "expected the header `{}`, found `{}`",
-                    HEADER.join(","),
-                    found.join(",")
-                ),
-            ));
+            return Err(header_error(&found, &HEADER, "header", &err));
         }
-        let preamble = text
-            .lines()
-            .take_while(|l| l.trim_start().starts_with('#'))
-            .map(str::to_string)
-            .collect();
+        let preamble = comment_preamble(text);
         let mut rows = Vec::new();
         let mut lines = Vec::new();
         for rec in rdr.records() {
@@ -817,6 +813,39 @@ fn parse_row(
 /// The rest of [`LimitTable::parse`] for a table whose header names the
 /// swing-twist model (`found`): its rows, each joint once, and their boxes as
 /// the Euler rows.
+/// The error of a header `found` that is not `want`, located at its first
+/// field that differs (1-based), or the first one missing.
+fn header_error(
+    found: &[&str],
+    want: &[&str],
+    what: &str,
+    err: &dyn Fn(u64, usize, String) -> LimitsError,
+) -> LimitsError {
+    let column = found
+        .iter()
+        .zip(want)
+        .position(|(f, h)| f != h)
+        .unwrap_or(found.len().min(want.len()))
+        + 1;
+    err(
+        1,
+        column,
+        format!(
+            "expected the {what} `{}`, found `{}`",
+            want.join(","),
+            found.join(",")
+        ),
+    )
+}
+
+/// The `#` comment lines a table file starts with (kept when it is saved).
+fn comment_preamble(text: &str) -> Vec<String> {
+    text.lines()
+        .take_while(|l| l.trim_start().starts_with('#'))
+        .map(str::to_string)
+        .collect()
+}
+
 fn parse_swing_twist(
     text: &str,
     mut rdr: csv::Reader<&[u8]>,
@@ -825,27 +854,9 @@ fn parse_swing_twist(
 ) -> Result<LimitTable, LimitsError> {
     let want = swing_twist::HEADER;
     if found != want {
-        let column = found
-            .iter()
-            .zip(want)
-            .position(|(f, h)| *f != h)
-            .unwrap_or(found.len().min(want.len()))
-            + 1;
-        return Err(err(
-            1,
-            column,
-            format!(
-                "expected the swing-twist header `{}`, found `{}`",
-                want.join(","),
-                found.join(",")
-            ),
-        ));
+        return Err(header_error(found, &want, "swing-twist header", err));
     }
-    let preamble = text
-        .lines()
-        .take_while(|l| l.trim_start().starts_with('#'))
-        .map(str::to_string)
-        .collect();
+    let preamble = comment_preamble(text);
     let mut st: Vec<swing_twist::SwingTwistRow> = Vec::new();
     let mut lines: Vec<u64> = Vec::new();
     for rec in rdr.records() {

@@ -16,7 +16,7 @@ use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::{JointLimits, LimitTable, Settings};
 use acm_workbench::model::Model;
-use acm_workbench::rotation::{euler_zyx_deg, y_beyond_90, Quat};
+use acm_workbench::rotation::Quat;
 use acm_workbench::simulate::{simulate, HeadingDrift, SimConfig};
 use acm_workbench::trial::{read_trial, Trial};
 use std::path::Path;
@@ -41,22 +41,17 @@ const SUM_REL: f64 = 1e-5;
 /// joints (`SUM_REL`) is where "no worse" is asserted.
 const REL: f64 = 2e-3;
 
-/// Half-width of the zone about a middle Z-Y-X angle of +-90 deg where a
-/// joint whose Y range reaches beyond 90 reads samples in either triplet
-/// (docs/method.md section 2.5), degrees.
-const SINGULAR_ZONE_DEG: f64 = 15.0;
-
-/// Whether the limits read two triplets and some sample of the joint, as
-/// measured or as corrected, lies within [`SINGULAR_ZONE_DEG`] of +-90 deg of
-/// middle angle (for this joint or one its lookahead sees). The objective then has one basin per reading; the
+/// Whether [`JointLimits::near_the_other_triplet`] holds for some sample of
+/// the joint (as measured or as corrected; for this joint or one its
+/// lookahead sees). The objective then has one basin per reading; the
 /// alternation keeps to the one its start is in while Nelder-Mead's restarts
 /// may find a lower one that is further from the truth (tests/solver_oracle.rs
 /// says more). Such joints are counted, not compared.
 fn near_the_other_triplet(parent: &[Quat], child: &[Quat], lim: &JointLimits) -> bool {
-    y_beyond_90(&lim.range_deg)
-        && parent.iter().zip(child).any(|(p, c)| {
-            euler_zyx_deg(&lim.to_axes(&(p.inverse() * c)))[1].abs() >= 90.0 - SINGULAR_ZONE_DEG
-        })
+    parent
+        .iter()
+        .zip(child)
+        .any(|(p, c)| lim.near_the_other_triplet(&(p.inverse() * c)))
 }
 
 struct Tally {

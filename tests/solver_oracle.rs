@@ -11,7 +11,7 @@ use acm_workbench::correct::correct_trial;
 use acm_workbench::limits::JointLimits;
 use acm_workbench::limits::{LimitTable, Settings};
 use acm_workbench::model::Model;
-use acm_workbench::rotation::{euler_zyx_deg, quat_from_wxyz, y_beyond_90, Quat};
+use acm_workbench::rotation::{quat_from_wxyz, Quat};
 use acm_workbench::simulate::{simulate, SimConfig};
 use acm_workbench::trial::{read_trial, Trial};
 use std::path::Path;
@@ -19,23 +19,15 @@ use std::path::Path;
 /// Relative margin allowed to Nelder-Mead.
 const REL: f64 = 1e-7;
 
-/// Half-width of the zone about a middle Z-Y-X angle of +-90 deg where a
-/// joint whose Y range reaches beyond 90 reads samples in either triplet
-/// (docs/method.md section 2.5), degrees.
-const SINGULAR_ZONE_DEG: f64 = 15.0;
-
-/// Whether the limits read two triplets and some sample of `span` corrected
-/// by `c` lies within [`SINGULAR_ZONE_DEG`] of +-90 deg of middle angle. There
-/// the cost has one basin per reading, and a descent from the uncorrected
-/// start keeps to the one it starts in while Nelder-Mead's restarts may find
-/// a lower one: on the crawl (`tests/deep_flexion.rs`) the lower basin puts
-/// the knee 14 deg from the truth, where the start's holds it at the noise.
-/// Such windows are counted, not compared.
+/// Windows where [`JointLimits::near_the_other_triplet`] holds for some
+/// sample (uncorrected, or corrected by either solver) have one cost basin
+/// per reading: a descent from the uncorrected start keeps to the one it
+/// starts in while Nelder-Mead's restarts may find a lower one, and on the
+/// crawl (`tests/deep_flexion.rs`) the lower basin puts the knee 14 deg from
+/// the truth where the start's holds it at the noise. Such windows are
+/// counted, not compared.
 fn near_the_other_triplet(span: &[Quat], c: &Quat, lim: &JointLimits) -> bool {
-    y_beyond_90(&lim.range_deg)
-        && span
-            .iter()
-            .any(|m| euler_zyx_deg(&lim.to_axes(&(m * c)))[1].abs() >= 90.0 - SINGULAR_ZONE_DEG)
+    span.iter().any(|m| lim.near_the_other_triplet(&(m * c)))
 }
 
 struct Tally {

@@ -175,14 +175,24 @@ pub fn run_suggest(a: SuggestArgs) -> anyhow::Result<i32> {
         span.label(),
         ctx.limits_source
     )?;
-    for line in s.diff_lines() {
+    finish_suggestion(&a, s.diff_lines(), &s.table)
+}
+
+/// A suggestion's end: its diff lines printed, and the table written to
+/// `--out` (beside the original's comments) unless `--dry-run`.
+fn finish_suggestion(
+    a: &SuggestArgs,
+    diff: impl IntoIterator<Item = String>,
+    table: &acm_workbench::limits::LimitTable,
+) -> anyhow::Result<i32> {
+    for line in diff {
         outln!("{line}")?;
     }
     if a.dry_run {
         return Ok(super::EXIT_OK);
     }
     let original = original_table(&a.table)?;
-    write_table(&s.table, &a.out, Some(&original))?;
+    write_table(table, &a.out, Some(&original))?;
     outln!("wrote {}", a.out.display())?;
     Ok(super::EXIT_OK)
 }
@@ -215,16 +225,7 @@ fn run_suggest_swing_twist(
             "<built-in swing_twist.csv>"
         }
     )?;
-    for line in s.diff_lines() {
-        outln!("{line}")?;
-    }
-    if a.dry_run {
-        return Ok(super::EXIT_OK);
-    }
-    let original = original_table(&a.table)?;
-    write_table(&s.table, &a.out, Some(&original))?;
-    outln!("wrote {}", a.out.display())?;
-    Ok(super::EXIT_OK)
+    finish_suggestion(a, s.diff_lines(), &s.table)
 }
 
 /// Runs `acmw centroids`.
