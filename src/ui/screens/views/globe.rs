@@ -120,11 +120,24 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
     f.render_widget(
         Paragraph::new(Line::from(vec![
             Span::styled(format!(" {} ", d.joint.name), theme.title),
+            // A swing-twist table's axes are its swing components and its
+            // twist (for the shipped table, Y, Z and X whatever the joint).
             Span::raw(format!(
-                "{} direction; flexion ({}) up, ab/adduction ({}) right, rotation ({}) in colour  ",
+                "{} direction; {} ({}) up, {} ({}) right, {} ({}) in colour  ",
                 d.joint.distal,
+                if swing.is_some() {
+                    "swing_1"
+                } else {
+                    "flexion"
+                },
                 name(axes.flexion),
+                if swing.is_some() {
+                    "swing_2"
+                } else {
+                    "ab/adduction"
+                },
                 name(axes.abduction),
+                if swing.is_some() { "twist" } else { "rotation" },
                 name(axes.rotation)
             )),
             Span::styled(format!("grid {every:.0} deg  t time colour"), theme.dim),
