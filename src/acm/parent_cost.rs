@@ -209,6 +209,8 @@ impl ParentCost {
     /// `sum_i excursion(c_p^-1 b_i)` on swing-twist limits (degrees); with
     /// `bg`, adds `sum_i B_i g_i` to it (`g_i` the sample's gradient in the
     /// right tangent of `Rt_i`, degrees per radian).
+    // Indexed loops over the parallel arrays of the samples.
+    #[allow(clippy::needless_range_loop)]
     fn swing_sum(&self, st: &SwingTerms, c_p: &Quat, bg: Option<&mut [f64; 3]>) -> f64 {
         let q = &self.samples.q;
         let b = &self.samples.b;
