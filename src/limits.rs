@@ -118,6 +118,27 @@ impl JointLimits {
         }
     }
 
+    /// Per joint rotation of `rotations` (segment frames, distal in
+    /// proximal), its excursion beyond these limits in the swing-twist model
+    /// when they are of it ([`swing_twist`]; `None` for an Euler box). The
+    /// limits are the table's own (not [`JointLimits::in_table_axes`]); the
+    /// rotations are read in the table's axes as the ACM's cost reads them
+    /// (docs/method.md section 5.1), in degrees.
+    pub fn swing_twist_parts(
+        &self,
+        joint: &crate::model::Joint,
+        rotations: impl Iterator<Item = crate::rotation::Quat>,
+    ) -> Option<Vec<swing_twist::ExcursionParts>> {
+        self.swing_twist?;
+        let lim = self.in_table_axes(joint);
+        let st = lim.swing_twist?;
+        Some(
+            rotations
+                .map(|r| st.excursion_parts(crate::rotation::wxyz(&lim.to_axes(&r))))
+                .collect(),
+        )
+    }
+
     /// Whether these limits read the joint rotation `r` (segment frames) in
     /// two Z-Y-X triplets (a Y range beyond +-90 deg) and its middle angle
     /// lies within [`TWO_READINGS_ZONE_DEG`] of +-90: there the ACM cost has

@@ -2,6 +2,8 @@
 //!
 //! All angles are degrees; joint angles are the Z-Y-X Euler angles of
 //! `(G_R_prox)^T * G_R_dist` taken from whichever trial is given (raw or corrected).
+//! Excursions count by the limit table's own model: the Euler box on those
+//! angles, or a swing-twist table's region and twist range on the rotations.
 
 use crate::acm::cost::excursion;
 use crate::limits::{JointLimits, LimitTable};
@@ -79,6 +81,61 @@ pub fn excursion_figures(angles: &[[f64; 3]], limits: &JointLimits) -> Excursion
         mean_excursion_deg: sum.map(|s| s / n),
         joint_mean_excursion_deg: sum.iter().sum::<f64>() / n,
         pct_outside_any: 100.0 * any as f64 / n,
+    }
+}
+
+/// Excursion figures of one joint against swing-twist limits, from each
+/// sample's excursion in its parts ([`JointLimits::swing_twist_parts`]): a
+/// sample is outside when its swing lies beyond the region or its twist
+/// beyond its range, as the ACM's cost counts it. Per axis: the twist axis
+/// (`twist_axis`, 0 = X) counts the twist's excursion, each swing axis the
+/// size of the swing's offset from the region's nearest point along it (so
+/// the per-axis means may add up to more than the joint's, which is the
+/// offset's length plus the twist's excursion), degrees.
+pub fn swing_twist_excursion_figures(
+    parts: &[crate::limits::swing_twist::ExcursionParts],
+    twist_axis: usize,
+) -> ExcursionFigures {
+    let n = parts.len().max(1) as f64;
+    let mut out_count = [0usize; 3];
+    let mut any = 0usize;
+    let mut sum = [0.0; 3];
+    let mut total = 0.0;
+    for p in parts {
+        let e = p.per_axis(twist_axis);
+        for k in 0..3 {
+            sum[k] += e[k];
+            out_count[k] += usize::from(e[k] > ON_LIMIT_DEG);
+        }
+        total += p.swing_deg + p.twist_deg;
+        any += usize::from(p.swing_deg > ON_LIMIT_DEG || p.twist_deg > ON_LIMIT_DEG);
+    }
+    ExcursionFigures {
+        pct_outside: out_count.map(|c| 100.0 * c as f64 / n),
+        mean_excursion_deg: sum.map(|s| s / n),
+        joint_mean_excursion_deg: total / n,
+        pct_outside_any: 100.0 * any as f64 / n,
+    }
+}
+
+/// A joint's excursion figures against its limits in the table's own model:
+/// the Euler box on `angles` ([`excursion_figures`]), or swing-twist limits
+/// on the joint rotations of `trial` ([`swing_twist_excursion_figures`]).
+pub fn joint_excursion_figures(
+    trial: &Trial,
+    joint: &Joint,
+    angles: &[[f64; 3]],
+    limits: &JointLimits,
+) -> ExcursionFigures {
+    let parts = limits.swing_twist.and_then(|st| {
+        let p = &trial.imu(&joint.proximal)?.orientation;
+        let d = &trial.imu(&joint.distal)?.orientation;
+        let rotations = p.iter().zip(d).map(|(p, d)| p.inverse() * d);
+        Some((limits.swing_twist_parts(joint, rotations)?, st.twist_axis))
+    });
+    match parts {
+        Some((parts, axis)) => swing_twist_excursion_figures(&parts, axis),
+        None => excursion_figures(angles, limits),
     }
 }
 
@@ -188,7 +245,7 @@ pub fn trial_figures(
             });
             Some(JointFigures {
                 joint: joint.name.clone(),
-                excursion: excursion_figures(&angles, &lim),
+                excursion: joint_excursion_figures(trial, joint, &angles, &lim),
                 shift,
                 truth,
             })

@@ -15,7 +15,8 @@
 //! ```
 //!
 //! - `excursion`: the joint's mean excursion beyond the table's limits (the
-//!   figure of section 16, without the centroid term);
+//!   figure of section 16, without the centroid term), in the table's own
+//!   model (Euler box or swing-twist);
 //! - `wobble`: how far the correction moves between windows beyond what its
 //!   model explains: for the windowed sensor-frame variants the RMS angle of
 //!   the window corrections about their mean (a strap misalignment is
@@ -255,10 +256,18 @@ fn figures_of(
     c: &Candidate,
     angles: &[Vec<[f64; 3]>],
 ) -> CandidateFigures {
-    let excursion_deg = j
-        .limits
-        .as_ref()
-        .map_or(0.0, |l| joint_mean_excursion_deg(&angles[i], &l.range_deg));
+    // By the table's own model: a swing-twist table's excursion is the
+    // swing's beyond its region plus the twist's beyond its range.
+    let excursion_deg = j.limits.as_ref().map_or(0.0, |l| {
+        let rotations = j.parent.iter().zip(&c.distal).map(|(p, d)| p.inverse() * d);
+        match l.swing_twist_parts(j.joint, rotations) {
+            Some(parts) => {
+                parts.iter().map(|p| p.swing_deg + p.twist_deg).sum::<f64>()
+                    / parts.len().max(1) as f64
+            }
+            None => joint_mean_excursion_deg(&angles[i], &l.range_deg),
+        }
+    });
     let n = j.raw.len().max(1) as f64;
     let correction_deg = j
         .raw

@@ -319,17 +319,8 @@ fn plan_joints(
 ) -> (Vec<(usize, JointLimits)>, Vec<SkippedJoint>) {
     let mut skipped = Vec::new();
     let mut todo: Vec<(usize, JointLimits)> = Vec::new();
-    // A swing-twist table with a variant whose costs read Euler ranges only:
-    // every joint is skipped, with the reason.
-    let refused = limits
-        .swing_twist
-        .as_ref()
-        .and_then(|_| crate::limits::swing_twist::refusal(variant));
     for (k, joint) in model.joints.iter().enumerate() {
-        match refused
-            .clone()
-            .or_else(|| skip_reason(trial, joint, limits))
-        {
+        match skip_reason(trial, joint, limits) {
             Some(reason) => skipped.push(SkippedJoint {
                 joint: joint.name.clone(),
                 reason,

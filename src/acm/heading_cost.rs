@@ -10,11 +10,16 @@
 //! are kept. The quaternion of `Rt(h)` is `cos(h/2) a + sin(h/2) b` likewise, so
 //! the centroid term costs two dot products per sample prepared once.
 //!
+//! With swing-twist limits ([`crate::limits::swing_twist`]) the excursion is
+//! that model's, of the quaternion `cos(h/2) a + sin(h/2) b` (kept per sample
+//! instead of the entries), its derivative in `h` through the model's gradient.
+//!
 //! The value is the window cost of docs/method.md section 5 with the heading term:
 //! `e(C, h) = (1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i)
 //!            + lambda1 * angle(C) + lambda1 * |h|` (degrees).
 
 use super::cost::LimitTerms;
+use super::swing_cost::SwingTerms;
 use crate::limits::JointLimits;
 use crate::rotation::{angle_deg, Quat};
 use nalgebra::{Quaternion, Vector3};
@@ -72,10 +77,30 @@ impl Sample {
     }
 }
 
+/// The two quaternions `a = P^T B` and `b = P^T (0, -up) B` (`[w, x, y, z]`)
+/// of a sample: its joint rotation at heading `h` has the quaternion
+/// `cos(h/2) a + sin(h/2) b`.
+fn heading_quats(p: &Quat, b: &Quat, up: &Vector3<f64>) -> [[f64; 4]; 2] {
+    let pt = p.inverse().into_inner();
+    let minus_up = Quaternion::new(0.0, -up[0], -up[1], -up[2]);
+    let qa = pt * b.into_inner();
+    let qb = pt * minus_up * b.into_inner();
+    [[qa.w, qa.i, qa.j, qa.k], [qb.w, qb.i, qb.j, qb.k]]
+}
+
+/// `ch a + sh b`, componentwise.
+#[inline(always)]
+fn mix([a, b]: &[[f64; 4]; 2], ch: f64, sh: f64) -> [f64; 4] {
+    std::array::from_fn(|k| ch * a[k] + sh * b[k])
+}
+
 /// The cost of one joint over one window as a function of the heading correction.
 #[derive(Debug, Clone)]
 pub struct HeadingCost {
     samples: Vec<Sample>,
+    /// Swing-twist limits, in place of `terms`' ranges (its centroid stays),
+    /// with each sample's two quaternions ([`heading_quats`]).
+    swing: Option<(SwingTerms, Vec<[[f64; 4]; 2]>)>,
     terms: LimitTerms,
     lambda1: f64,
     /// `lambda1 * angle(C)`.
@@ -111,8 +136,21 @@ impl HeadingCost {
                 }
             })
             .collect();
+        let swing = limits.swing_twist.map(|st| {
+            let quats = parent
+                .iter()
+                .zip(child)
+                .step_by(stride.max(1))
+                .map(|(p, d)| match &limits.axes {
+                    Some(a) => heading_quats(&(p * a.q), &(d * c * a.q), &up),
+                    None => heading_quats(p, &(d * c), &up),
+                })
+                .collect();
+            (SwingTerms::new(st), quats)
+        });
         HeadingCost {
             samples,
+            swing,
             terms,
             lambda1,
             c_penalty: lambda1 * angle_deg(c),
@@ -140,9 +178,17 @@ impl HeadingCost {
         let (sh, ch) = (0.5 * h_deg.to_radians()).sin_cos();
         let centroid = self.terms.centroid.is_some();
         let mut sum = 0.0;
+        if let Some((st, quats)) = &self.swing {
+            for q in quats {
+                sum += st.excursion(mix(q, ch, sh));
+            }
+        }
+        let euler = self.swing.is_none();
         for p in &self.samples {
-            let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
-            sum += self.terms.excursion([r(0), r(1), r(2), r(3), r(4)]);
+            if euler {
+                let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
+                sum += self.terms.excursion([r(0), r(1), r(2), r(3), r(4)]);
+            }
             if centroid {
                 sum += self
                     .terms
@@ -167,15 +213,26 @@ impl HeadingCost {
         let (sh, ch) = (0.5 * h_deg.to_radians()).sin_cos();
         let centroid = self.terms.centroid.is_some();
         let (mut sum, mut slope) = (0.0, 0.0);
+        if let Some((st, quats)) = &self.swing {
+            // dq/dh = (-sin(h/2) a + cos(h/2) b) / 2, per radian.
+            for q in quats {
+                let (e, de) = st.excursion_along(mix(q, ch, sh), mix(q, -0.5 * sh, 0.5 * ch));
+                sum += e;
+                slope += de;
+            }
+        }
+        let euler = self.swing.is_none();
         for p in &self.samples {
-            let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
-            let d = |j: usize| c * p.m1[j] + s * p.m2[j];
-            let (e, de) = self.terms.excursion_along(
-                [r(0), r(1), r(2), r(3), r(4)],
-                [d(0), d(1), d(2), d(3), d(4)],
-            );
-            sum += e;
-            slope += de;
+            if euler {
+                let r = |j: usize| p.m0[j] + s * p.m1[j] + v * p.m2[j];
+                let d = |j: usize| c * p.m1[j] + s * p.m2[j];
+                let (e, de) = self.terms.excursion_along(
+                    [r(0), r(1), r(2), r(3), r(4)],
+                    [d(0), d(1), d(2), d(3), d(4)],
+                );
+                sum += e;
+                slope += de;
+            }
             if centroid {
                 let [a, b] = p.centroid_dots;
                 let (e, de) = self

@@ -9,12 +9,16 @@
 //! of `C_p^T` and the columns of `B`; the centroid term uses
 //! `(c_p^-1 b) . q_c = b . (c_p q_c)`, one 4-vector per evaluation.
 //!
+//! With swing-twist limits ([`crate::limits::swing_twist`]) the excursion is
+//! that model's, of the quaternion `c_p^-1 b` per sample.
+//!
 //! The value is the mean per-sample part of the window cost of docs/method.md
 //! section 5, without any `lambda1` term (the penalties of `C_p` and of the
 //! distal IMU's correction are counted by the caller, once each):
 //! `(1/n) sum_i (Ex_i + Ey_i + Ez_i + lambda2 * RMSq_i)`, degrees.
 
 use super::cost::{matrix_vectors, LimitTerms, BLOCK};
+use super::swing_cost::SwingTerms;
 use crate::limits::JointLimits;
 use crate::rotation::Quat;
 use nalgebra::{Quaternion, Vector3};
@@ -36,6 +40,8 @@ pub struct ParentCost {
     terms: LimitTerms,
     /// The child joint's limit axes: `C_p` is evaluated as `Q^T C_p Q`.
     axes: Option<crate::model::TableAxes>,
+    /// Swing-twist limits, in place of `terms`' ranges (its centroid stays).
+    swing: Option<SwingTerms>,
 }
 
 impl ParentCost {
@@ -57,6 +63,7 @@ impl ParentCost {
             samples,
             terms: LimitTerms::new(limits),
             axes: limits.axes,
+            swing: limits.swing_twist.map(SwingTerms::new),
         }
     }
 
@@ -118,7 +125,15 @@ impl ParentCost {
         let mut sum = 0.0;
         let mut bg = [0.0; 3];
         let mut e = [[0.0; BLOCK]; 5];
-        let mut start = 0;
+        // Swing-twist limits take the samples' excursions in place of the
+        // Euler ranges' loop below, which then has nothing left to do.
+        let mut start = match &self.swing {
+            Some(st) => {
+                sum += self.swing_sum(st, c_p, grad.is_some().then_some(&mut bg));
+                n
+            }
+            None => 0,
+        };
         while start < n {
             let len = BLOCK.min(n - start);
             let col = |k: usize| &b[k][start..start + len];
@@ -187,6 +202,50 @@ impl ParentCost {
             *out = g / n;
         }
         sum / n
+    }
+}
+
+impl ParentCost {
+    /// `sum_i excursion(c_p^-1 b_i)` on swing-twist limits (degrees); with
+    /// `bg`, adds `sum_i B_i g_i` to it (`g_i` the sample's gradient in the
+    /// right tangent of `Rt_i`, degrees per radian).
+    // Indexed loops over the parallel arrays of the samples.
+    #[allow(clippy::needless_range_loop)]
+    fn swing_sum(&self, st: &SwingTerms, c_p: &Quat, bg: Option<&mut [f64; 3]>) -> f64 {
+        let q = &self.samples.q;
+        let b = &self.samples.b;
+        // conj(c_p) * b_i, componentwise.
+        let (cw, cx, cy, cz) = (c_p.w, -c_p.i, -c_p.j, -c_p.k);
+        let qt = |i: usize| -> [f64; 4] {
+            let (w, x, y, z) = (q[0][i], q[1][i], q[2][i], q[3][i]);
+            [
+                cw * w - cx * x - cy * y - cz * z,
+                cw * x + cx * w + cy * z - cz * y,
+                cw * y - cx * z + cy * w + cz * x,
+                cw * z + cx * y - cy * x + cz * w,
+            ]
+        };
+        let mut sum = 0.0;
+        match bg {
+            None => {
+                for i in 0..self.len() {
+                    sum += st.excursion(qt(i));
+                }
+            }
+            Some(bg) => {
+                for i in 0..self.len() {
+                    let (e, g) = st.excursion_grad(qt(i));
+                    sum += e;
+                    if g != [0.0; 3] {
+                        // B_i g: entry (r, j) of B_i is b[3 j + r].
+                        for (r, out) in bg.iter_mut().enumerate() {
+                            *out += b[r][i] * g[0] + b[3 + r][i] * g[1] + b[6 + r][i] * g[2];
+                        }
+                    }
+                }
+            }
+        }
+        sum
     }
 }
 

@@ -18,6 +18,41 @@ impl SwingTerms {
         SwingTerms { limits }
     }
 
+    /// The excursion (degrees) of one rotation with quaternion `q` (`[w, x,
+    /// y, z]`, the limits' axes).
+    #[inline]
+    pub(super) fn excursion(&self, q: [f64; 4]) -> f64 {
+        self.limits.excursion(q)
+    }
+
+    /// The excursion of `q` and its gradient (degrees per radian) with
+    /// respect to a rotation vector `v` of `R * exp(v)` at `v = 0`.
+    #[inline]
+    pub(super) fn excursion_grad(&self, q: [f64; 4]) -> (f64, [f64; 3]) {
+        self.limits.excursion_grad(q)
+    }
+
+    /// The excursion of `q` and its derivative (degrees per radian) along a
+    /// path on which the unit quaternion moves at rate `dq` (per radian):
+    /// `dq = q * (0, w / 2)` with `w = 2 Im(q^-1 dq)`, so the derivative is
+    /// the gradient dotted with `w`.
+    #[inline]
+    pub(super) fn excursion_along(&self, q: [f64; 4], dq: [f64; 4]) -> (f64, f64) {
+        let (e, g) = self.limits.excursion_grad(q);
+        if g == [0.0; 3] {
+            return (e, 0.0);
+        }
+        let [w, x, y, z] = q;
+        let [dw, dx, dy, dz] = dq;
+        // Im(conj(q) dq) = w dv - dw v - v x dv.
+        let rate = [
+            2.0 * (w * dx - dw * x - (y * dz - z * dy)),
+            2.0 * (w * dy - dw * y - (z * dx - x * dz)),
+            2.0 * (w * dz - dw * z - (x * dy - y * dx)),
+        ];
+        (e, g[0] * rate[0] + g[1] * rate[1] + g[2] * rate[2])
+    }
+
     /// `sum_i excursion(q_i * c)` (degrees) over quaternions held as
     /// component arrays `q` (`[w, x, y, z]`, the limits' axes), `c` the
     /// correction in the same axes. With `grad`, adds to it the sum's

@@ -85,9 +85,6 @@ pub fn run(args: BatchArgs) -> anyhow::Result<i32> {
             variants.push(*v);
         }
     }
-    for v in &variants {
-        super::common::check_variant_limits(&ctx, *v)?;
-    }
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));

@@ -255,23 +255,6 @@ pub fn load_context(
     })
 }
 
-/// An error when `variant` cannot correct with the context's limit table (a
-/// swing-twist table with a variant whose costs read Euler ranges only).
-pub fn check_variant_limits(ctx: &Context, variant: Variant) -> Result<(), LimitsError> {
-    match ctx.limits.swing_twist.as_ref() {
-        Some(_) => match acm_workbench::limits::swing_twist::refusal(variant) {
-            Some(message) => Err(LimitsError {
-                file: ctx.limits_source.clone(),
-                line: 0,
-                column: 0,
-                message,
-            }),
-            None => Ok(()),
-        },
-        None => Ok(()),
-    }
-}
-
 /// The CSV text of a limit table by its source (a path, or `<built-in NAME>`),
 /// for locating a coverage error; `None` when it cannot be read again.
 fn table_text(source: &str) -> Option<String> {

@@ -99,7 +99,6 @@ pub fn run(args: CorrectArgs) -> anyhow::Result<i32> {
             (ctx, args.variant, pose, file)
         }
     };
-    super::common::check_variant_limits(&ctx, variant)?;
     args.output_precision.apply(&mut ctx.settings);
     let calibration = match recorded_calibration {
         Some(c) => Some(c),

@@ -54,6 +54,32 @@ pub struct SwingTwistLimits {
     pub edge_twist_deg: [f64; 2],
 }
 
+/// The excursion of one rotation beyond swing-twist limits in its parts,
+/// degrees.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExcursionParts {
+    /// The swing's distance beyond the region (0 inside).
+    pub swing_deg: f64,
+    /// The swing less the region's nearest point, on `swing_1` and `swing_2`
+    /// (its length is `swing_deg`; 0 inside).
+    pub swing_offset_deg: [f64; 2],
+    /// The twist beyond its range at the swing's radius (0 inside).
+    pub twist_deg: f64,
+}
+
+impl ExcursionParts {
+    /// Per table axis X, Y, Z: the twist's excursion on the twist axis, the
+    /// size of the swing offset's component on each swing axis, degrees.
+    pub fn per_axis(&self, twist_axis: usize) -> [f64; 3] {
+        let mut out = [0.0; 3];
+        out[twist_axis] = self.twist_deg;
+        for (k, a) in swing_axes(twist_axis).into_iter().enumerate() {
+            out[a] = self.swing_offset_deg[k].abs();
+        }
+        out
+    }
+}
+
 /// The swing-twist coordinates of a rotation, degrees.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SwingTwist {
@@ -148,7 +174,30 @@ impl SwingTwistLimits {
         (e.v, e.d)
     }
 
+    /// The excursion of the rotation with quaternion `q` (`[w, x, y, z]`,
+    /// the table's axes) in its parts, degrees: what the report's per-axis
+    /// figures count. `swing_deg + twist_deg` is [`SwingTwistLimits::excursion`].
+    pub fn excursion_parts(&self, q: [f64; 4]) -> ExcursionParts {
+        let (swing_deg, twist_deg, swing) = self.parts_of(q);
+        let p = [swing[0] - self.centre_deg[0], swing[1] - self.centre_deg[1]];
+        let swing_offset_deg = match self.nearest(p) {
+            Some((_, near)) => [p[0] - near[0], p[1] - near[1]],
+            None => [0.0, 0.0],
+        };
+        ExcursionParts {
+            swing_deg,
+            swing_offset_deg,
+            twist_deg,
+        }
+    }
+
     fn excursion_of<S: Scalar>(&self, q: [S; 4]) -> S {
+        let (swing_e, twist_e, _) = self.parts_of(q);
+        swing_e + twist_e
+    }
+
+    /// The swing's excursion, the twist's and the swing's coordinates.
+    fn parts_of<S: Scalar>(&self, q: [S; 4]) -> (S, S, [f64; 2]) {
         let [s1, s2, tw] = coordinates(self.twist_axis, q);
         let swing = [s1, s2];
         let swing_e = self.beyond_ellipse(swing);
@@ -173,17 +222,13 @@ impl SwingTwistLimits {
         } else {
             S::from(0.0)
         };
-        swing_e + twist_e
+        (swing_e, twist_e, [s1.val(), s2.val()])
     }
 
-    /// Distance (degrees) of a swing beyond the ellipse, 0 inside; its
-    /// derivatives are those of the distance from the nearest point of the
-    /// ellipse, which moves along the outward normal.
-    fn beyond_ellipse<S: Scalar>(&self, swing: [S; 2]) -> S {
-        let p = [
-            swing[0].val() - self.centre_deg[0],
-            swing[1].val() - self.centre_deg[1],
-        ];
+    /// The distance of a swing offset `p` from the centre (degrees) beyond
+    /// the region and the region's nearest point (relative to the centre);
+    /// `None` inside.
+    fn nearest(&self, p: [f64; 2]) -> Option<(f64, [f64; 2])> {
         let [a, b] = self.half_deg;
         let (d, near) = match self.corner_deg {
             Some(r) => {
@@ -194,7 +239,7 @@ impl SwingTwistLimits {
                 ];
                 let len = (q[0] * q[0] + q[1] * q[1]).sqrt();
                 if len <= r {
-                    return S::from(0.0);
+                    return None;
                 }
                 let k = r / len;
                 let near = [
@@ -205,14 +250,25 @@ impl SwingTwistLimits {
             }
             None => {
                 if (p[0] / a).powi(2) + (p[1] / b).powi(2) <= 1.0 {
-                    return S::from(0.0);
+                    return None;
                 }
                 ellipse_distance(a, b, p)
             }
         };
-        if d <= 0.0 {
+        (d > 0.0).then_some((d, near))
+    }
+
+    /// Distance (degrees) of a swing beyond the ellipse, 0 inside; its
+    /// derivatives are those of the distance from the nearest point of the
+    /// ellipse, which moves along the outward normal.
+    fn beyond_ellipse<S: Scalar>(&self, swing: [S; 2]) -> S {
+        let p = [
+            swing[0].val() - self.centre_deg[0],
+            swing[1].val() - self.centre_deg[1],
+        ];
+        let Some((d, near)) = self.nearest(p) else {
             return S::from(0.0);
-        }
+        };
         let n = [(p[0] - near[0]) / d, (p[1] - near[1]) / d];
         // d = n . (swing - centre - near), with near fixed to first order.
         let dc = [self.centre_deg[0] + near[0], self.centre_deg[1] + near[1]];
@@ -471,19 +527,6 @@ impl Scalar for Dual {
             d: std::array::from_fn(|c| (x.v * y.d[c] - y.v * x.d[c]) * k),
         }
     }
-}
-
-/// Why `variant` cannot correct with a swing-twist table, if it cannot: the
-/// heading variants' costs read Euler ranges only, and `auto` tries them.
-pub fn refusal(variant: crate::variant::Variant) -> Option<String> {
-    use crate::variant::{Kind, Variant};
-    let heading = variant.kind() == Kind::Heading;
-    (heading || variant == Variant::Auto).then(|| {
-        format!(
-            "variant '{variant}' takes Euler limit tables only (its heading costs read Z-Y-X ranges); \
-             expected basic, drift, drift-centroid, hinge or a baseline with a swing-twist table"
-        )
-    })
 }
 
 /// The CSV header of a swing-twist limit table: it tells the loader the

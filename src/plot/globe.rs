@@ -123,8 +123,24 @@ impl Globe<'_> {
             .disable_mesh()
             .disable_x_axis()
             .disable_y_axis()
-            .x_desc(format!("ab/adduction ({}) ->", axis_name(a.abduction)))
-            .y_desc(format!("flexion ({}) ->", axis_name(a.flexion)))
+            .x_desc(format!(
+                "{} ({}) ->",
+                if self.swing.is_some() {
+                    "swing_2"
+                } else {
+                    "ab/adduction"
+                },
+                axis_name(a.abduction)
+            ))
+            .y_desc(format!(
+                "{} ({}) ->",
+                if self.swing.is_some() {
+                    "swing_1"
+                } else {
+                    "flexion"
+                },
+                axis_name(a.flexion)
+            ))
             .label_style((FONT, 12))
             .draw()
             .map_err(draw_err)?;

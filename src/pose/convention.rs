@@ -19,6 +19,14 @@
 //!   while none reach the other: an offset calibration pose, or none.
 //! * **axes swapped** (calibrated): a narrow axis (range within +-10 deg)
 //!   moving more than twice the expected flexion axis.
+//!
+//! The checks read Z-Y-X angles against Euler ranges whatever the table's
+//! model: with a swing-twist table ([`crate::limits::swing_twist`]) they read
+//! its Euler view, each axis' range the region's extent along it (the twist
+//! axis' the twist range: [`crate::limits::swing_twist::SwingTwistRow::euler_rows`]).
+//! A sign convention is a property of each axis' sense of motion, which that
+//! box states as the region does; the singularity the swing-twist model
+//! avoids lies at Y = +-90 deg, beyond the motions these checks look at.
 
 use crate::limits::LimitTable;
 use crate::metrics::joint_angles;

@@ -70,6 +70,12 @@ pub(super) fn snap(name: &str, app: &App) {
     }
 }
 
+/// A snapshot at one size `w` x `h`, named `{name}_{w}x{h}` as [`snap`]'s.
+pub(super) fn snap_at(name: &str, app: &App, w: u16, h: u16) {
+    let t = terminal(app, w, h);
+    insta::assert_snapshot!(format!("{name}_{w}x{h}"), t.backend());
+}
+
 /// Style snapshots (ANSI SGR per cell): under `NO_COLOR` at every size,
 /// where only glyphs and modifiers tell things apart, and in colour at
 /// 80x24.

@@ -1,7 +1,7 @@
 //! Flows and snapshots of the analysis views (scatter, globe, applied
 //! correction, stick figure), driven through `update` with fixed data.
 
-use super::{key, keys, snap, terminal, Fixture};
+use super::{key, keys, snap, snap_at, terminal, Fixture};
 use crate::simulate::{simulate, SimConfig};
 use crate::trial::{write_trial, TrialFormat};
 use crate::ui::app::{update, App, Msg};
@@ -68,6 +68,57 @@ fn scatter_and_globe_colour_the_classes_raw_beside_corrected() {
     snap("scatter_shoulder", &app);
     key(&mut app, KeyCode::Esc);
     assert_eq!(app.screen, Screen::Trial);
+}
+
+/// With a swing-twist table (`table = "swing_twist.csv"` in the limits
+/// folder) the globe draws the region's edge over the band in both panels,
+/// and names it; with the Euler table there is no edge. One size: the
+/// globe's snapshot at 120x40.
+#[test]
+fn globe_draws_a_swing_twist_region() {
+    use crate::ui::views::SWING_COLOUR;
+    // Cells of the edge's colour inside the panels (below their titles).
+    let edge_cells = |app: &App, x0: u16, x1: u16| -> usize {
+        let t = terminal(app, 120, 40);
+        let buf = t.backend().buffer();
+        (3..38)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .filter(|&(x, y)| buf[(x, y)].fg == SWING_COLOUR)
+            .count()
+    };
+    let fx = Fixture::new();
+    let mut euler = fx.app();
+    open_trial(&mut euler, "knee.csv");
+    keys(&mut euler, "o");
+    assert_eq!(edge_cells(&euler, 0, 120), 0);
+    let dir = fx.root().join("joint_limits");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("settings.toml"),
+        "table = \"swing_twist.csv\"\nlambda1 = 0.05\nwindow_s = 60.0\nhop_s = 30.0\n",
+    )
+    .unwrap();
+    let mut app = fx.app();
+    assert_eq!(app.limits.table.model_name(), "swing-twist");
+    open_trial(&mut app, "knee.csv");
+    keys(&mut app, "o");
+    assert_eq!(app.views.kind, ViewKind::Globe);
+    assert!(edge_cells(&app, 0, 60) > 10);
+    assert!(edge_cells(&app, 60, 120) > 10);
+    let text = format!("{}", terminal(&app, 120, 40).backend());
+    assert_eq!(text.matches("swing-twist edge").count(), 2, "{text}");
+    snap_at("globe_swing_twist", &app, 120, 40);
+    // The shoulder (twist about Y): the region's edge away from the band's.
+    let mut app = fx.app();
+    open_trial(&mut app, "fb.csv.gz");
+    app.joint = app
+        .open_joints()
+        .iter()
+        .position(|j| j == "l_shoulder")
+        .unwrap();
+    keys(&mut app, "o");
+    assert!(edge_cells(&app, 0, 60) > 10);
+    snap_at("globe_swing_twist_shoulder", &app, 120, 40);
 }
 
 #[test]

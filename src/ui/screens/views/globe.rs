@@ -2,16 +2,19 @@
 //! distal segment's direction on a sphere around the joint, seen from the
 //! middle of the limits; the flexion and ab/adduction limits as a yellow band;
 //! points coloured by limit class over all three axes (rotation, which cannot
-//! move a point, shows only in its colour), or by time with `t`.
+//! move a point, shows only in its colour), or by time with `t`. With a
+//! swing-twist table the region's edge is drawn over the band (its box), as
+//! `acmw plot globe` draws it, and each panel's title names it.
 
 use super::scatter::{colouring, legend_of};
 use super::Ctx;
 use super::{
     colour, draw_keys, joint_data, key_markers, marker, resolution, square_around, RasterShape,
-    BAND_COLOUR, CLASS_COLOURS, TIME_COLOURS,
+    BAND_COLOUR, CLASS_COLOURS, SWING_COLOUR, TIME_COLOURS,
 };
 use crate::analysis::globe::{
-    band_outline, band_raster, extent, globe_raster, grid_lines, rect_outline, GlobeView, JointAxes,
+    band_outline, band_raster, extent, globe_raster, grid_lines, rect_outline, swing_outline,
+    GlobeView, JointAxes,
 };
 use crate::analysis::scatter::{Colouring, Grid};
 use crate::ui::theme::Theme;
@@ -79,8 +82,14 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
     let mk = marker(app, theme);
     let outline = theme.glyphs(app.view.braille).outline;
     let keys = key_markers(app, theme, c == Colouring::Time);
-    // Zoom to the band and the samples (the thesis' plots show that region).
+    // A swing-twist table's region: its edge (unit directions, table axes).
+    let swing = limits
+        .and_then(|l| l.swing_twist)
+        .map(|st| swing_outline(&st, 128));
+    // Zoom to the band, the region and the samples (the thesis' plots show
+    // that region).
     let mut outlines = vec![band_outline(&range, axes, 24)];
+    outlines.extend(swing.clone());
     for a in std::iter::once(&d.raw).chain(d.cor.as_ref()) {
         if let Some([fl, ab]) = extent(a, axes) {
             outlines.push(rect_outline(fl, ab, axes, 24));
@@ -104,15 +113,31 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
         .iter()
         .flat_map(|l| visible_runs(&view, l))
         .collect();
+    let swing_runs = swing
+        .as_ref()
+        .map_or_else(Vec::new, |line| visible_runs(&view, line));
     let name = |k: usize| crate::limits::axis_name(k);
     f.render_widget(
         Paragraph::new(Line::from(vec![
             Span::styled(format!(" {} ", d.joint.name), theme.title),
+            // A swing-twist table's axes are its swing components and its
+            // twist (for the shipped table, Y, Z and X whatever the joint).
             Span::raw(format!(
-                "{} direction; flexion ({}) up, ab/adduction ({}) right, rotation ({}) in colour  ",
+                "{} direction; {} ({}) up, {} ({}) right, {} ({}) in colour  ",
                 d.joint.distal,
+                if swing.is_some() {
+                    "swing_1"
+                } else {
+                    "flexion"
+                },
                 name(axes.flexion),
+                if swing.is_some() {
+                    "swing_2"
+                } else {
+                    "ab/adduction"
+                },
                 name(axes.abduction),
+                if swing.is_some() { "twist" } else { "rotation" },
                 name(axes.rotation)
             )),
             Span::styled(format!("grid {every:.0} deg  t time colour"), theme.dim),
@@ -125,6 +150,7 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
     };
     let dim = colour(theme, theme.dim.fg.unwrap_or(Color::DarkGray));
     let band_colour = colour(theme, BAND_COLOUR);
+    let swing_colour = colour(theme, SWING_COLOUR);
     for (side, angles, label) in [
         (left, Some(&d.raw), "raw".to_string()),
         (right, d.cor.as_ref(), app.variant.to_string()),
@@ -136,7 +162,18 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
                 Block::new()
                     .borders(Borders::ALL)
                     .border_style(theme.dim)
-                    .title(Span::styled(title, theme.header)),
+                    .title(Line::from(vec![
+                        Span::styled(title, theme.header),
+                        // Names the edge drawn in its colour.
+                        Span::styled(
+                            if swing.is_some() {
+                                "swing-twist edge "
+                            } else {
+                                ""
+                            },
+                            theme.header.fg(swing_colour),
+                        ),
+                    ])),
             )
             .marker(mk)
             .x_bounds(bx)
@@ -158,6 +195,10 @@ pub fn render(app: &Ctx, e: &TrialEntry, theme: &Theme, f: &mut Frame, area: Rec
                     colours: &[band_colour],
                 });
                 ctx.layer();
+                if !swing_runs.is_empty() {
+                    draw_runs(ctx, &swing_runs, swing_colour);
+                    ctx.layer();
+                }
                 if outline != mk {
                     ctx.marker(mk);
                 }

@@ -184,6 +184,8 @@ pub const TIME_COLOURS: [Color; 6] = [
 ];
 /// The limit band of the globe (thesis: yellow).
 pub const BAND_COLOUR: Color = Color::Yellow;
+/// The edge of a swing-twist table's region on the globe.
+pub const SWING_COLOUR: Color = Color::Cyan;
 
 /// `c`, or no colour when the theme has none (`NO_COLOR`).
 pub fn colour(theme: &Theme, c: Color) -> Color {
