@@ -197,8 +197,7 @@ fn run(
                 &todo,
                 todo[i].0,
                 &mut hinges,
-                &windows,
-                settings.lambda1,
+                (&windows, settings.lambda1),
             );
         }
         let passes: Vec<Pass> = plans
@@ -694,7 +693,7 @@ impl ChildTerm {
         windows: &[Window],
     ) -> Option<ChildTerm> {
         let joint = &model.joints[c];
-        let limits = todo.iter().find(|(j, _)| *j == c)?.1.clone();
+        let limits = todo.iter().find(|(j, _)| *j == c)?.1;
         let p = trial.imu(&joint.proximal)?;
         let d = trial.imu(&joint.distal)?;
         let nd = Vector3::from(fits.hinge.segment_axes().1);
@@ -782,8 +781,7 @@ fn turn_uncorrected_proximal(
     todo: &[(usize, JointLimits)],
     k: usize,
     hinges: &mut HashMap<usize, HingeFits>,
-    windows: &[Window],
-    lambda1: f64,
+    (windows, lambda1): (&[Window], f64),
 ) {
     let joint = &model.joints[k];
     let Some(fits) = hinges.get_mut(&k) else {

@@ -640,6 +640,43 @@ mod tests {
     }
 
     #[test]
+    fn two_axes_are_refined_past_a_small_turn_about_the_third() {
+        // An elbow (pronation Z in the upper arm, flexion X in the forearm)
+        // whose Y also turns +-5 deg with zero mean, both sensors tilted.
+        let ma = quat_axis_angle_deg([1.0, 1.0, 0.0], 20.0);
+        let mb = quat_axis_angle_deg([0.0, 1.0, -1.0], 20.0);
+        let t: Vec<f64> = (0..3000).map(|i| f64::from(i) * 0.02).collect();
+        let rm: Vec<Quat> = (t.iter())
+            .map(|&s| {
+                let flex = 70.0 + 60.0 * (1.3 * s).sin();
+                let pro = 25.0 * (0.7 * s + 1.0).sin();
+                let y = 5.0 * (2.3 * s + 0.4).sin();
+                ma.inverse() * quat_from_euler_zyx_deg([flex, y, pro]) * mb
+            })
+            .collect();
+        let rates = rates_from_orientations(&t, &rm, 0.05);
+        let (want_a, want_b) = (ma.inverse() * Vector3::z(), mb.inverse() * Vector3::x());
+        let opts = MuellerOptions::default();
+        let (a, b) = refine_two_axes(&rm, &rates, (Vector3::z(), Vector3::x()), &opts);
+        let (ea, eb) = (
+            angle_between_axes_deg(&a, &want_a),
+            angle_between_axes_deg(&b, &want_b),
+        );
+        assert!(ea < 1.0 && eb < 1.0, "{ea} / {eb}");
+        // The window estimate the variant uses gives the same axes.
+        let (rec, axes) = estimate_window(
+            Hinge::two_axes_holding(crate::model::Axis::Y),
+            30.0,
+            &rm,
+            &rates,
+        );
+        assert!(rec.fallback.is_none(), "{rec:?}");
+        let ap = axes.proximal.unwrap();
+        assert!(angle_between_axes_deg(&ap, &want_a) < 1.0);
+        assert!(angle_between_axes_deg(&axes.distal.unwrap(), &want_b) < 1.0);
+    }
+
+    #[test]
     fn the_scan_finds_the_turn_a_cost_asks_for() {
         let fam = AxisFamily::new(&Vector3::y(), &Vector3::new(0.1, 1.0, 0.0).normalize());
         let target = fam.at(-123.4);
