@@ -197,7 +197,7 @@ fn run(
                 &todo,
                 todo[i].0,
                 &mut hinges,
-                &windows,
+                (&windows, settings.lambda1),
             );
         }
         let passes: Vec<Pass> = plans
@@ -387,7 +387,7 @@ impl Pass<'_> {
         if let Some(kept) = self.kept(k) {
             return Ok(kept);
         }
-        let families = axis_families(self.model, self.todo, self.hinges, k);
+        let families = axis_families(self.model, self.todo, self.hinges, k, self.settings.lambda1);
         let result = |windows, baseline| JointResult {
             joint: joint.name.clone(),
             proximal: joint.proximal.clone(),
@@ -445,7 +445,7 @@ impl Pass<'_> {
                 (&self.trial.time_s, &measured),
                 self.windows,
                 (lim, settings.lambda1, settings.solver),
-                &f.per_window,
+                (&f.per_window, self.child_term(f).as_ref(), f.turn_weight),
                 control,
                 &progress,
             )?,
@@ -491,6 +491,19 @@ impl Pass<'_> {
     }
 
     /// An earlier run's result for joint `k`, when the run re-solves other joints only.
+    /// The limits of the two-axis hinge below whose axis gave `families`.
+    fn child_term(&self, families: &Families) -> Option<ChildTerm> {
+        let c = families.two_axis_child?;
+        ChildTerm::new(
+            self.trial,
+            self.model,
+            self.todo,
+            self.hinges.get(&c)?,
+            c,
+            self.windows,
+        )
+    }
+
     fn kept(&self, k: usize) -> Option<Solved> {
         let (prev, redo) = self.reuse?;
         if redo.contains(&k) {
@@ -624,6 +637,81 @@ fn hinge_fits(
 struct Families {
     per_window: Vec<Option<AxisFamily>>,
     from_child: Option<String>,
+    /// The hinge joint below whose proximal axis gave the families, when it
+    /// has two axes: its limits on the turn about that axis join the cost.
+    two_axis_child: Option<usize>,
+    /// The weight of the turn about the axis in the size term, per degree:
+    /// `lambda1`, times [`TWO_AXIS_TURN_WEIGHT`] for a two-axis hinge's axis.
+    turn_weight: f64,
+}
+
+/// The limits of a two-axis hinge joint as a cost on the correction `C` of
+/// its proximal IMU (docs/method.md section 18): the turn of the proximal IMU
+/// about the hinge's proximal axis moves only the joint's proximal-axis angle
+/// (the elbow's pronation), which the distal IMU's turn about its own axis
+/// cannot reach, so the joint's own limits must decide it. Per window: the raw
+/// joint rotations `Rm_i` (raw proximal to raw distal IMU frame, at most
+/// [`CHILD_TERM_SAMPLES`] of them) and the least rotation `S_d` putting the
+/// distal axis on its segment axis; the cost of `C` is the joint's window cost
+/// of `C^-1 Rm_i S_d` without a size term.
+struct ChildTerm {
+    windows: Vec<(Vec<Quat>, Quat)>,
+    limits: JointLimits,
+}
+
+/// The weight of the turn about a two-axis hinge's axis in the size term, as
+/// a fraction of `lambda1` (docs/method.md section 18). The turn each axis
+/// leaves free moves one joint angle alone (the elbow's forearm: flexion; its
+/// upper arm: pronation), so the joint's limits on that angle are all there is
+/// to decide it; at the full `lambda1` (0.05 per degree) a turn is only taken
+/// while more than 5 % of the samples lie beyond a limit, and a forearm 20 deg
+/// off about its flexion axis kept all 20 (the flexion reading 18-181 deg
+/// against 0-160). At this fraction the turn goes where at most 0.1 % of the
+/// samples are beyond, and the size term still picks the least turn when the
+/// limits leave a range of them.
+pub const TWO_AXIS_TURN_WEIGHT: f64 = 0.02;
+
+/// Most samples per window in a [`ChildTerm`] (evenly spaced).
+const CHILD_TERM_SAMPLES: usize = 600;
+
+impl ChildTerm {
+    fn new(
+        trial: &Trial,
+        model: &Model,
+        todo: &[(usize, JointLimits)],
+        fits: &HingeFits,
+        c: usize,
+        windows: &[Window],
+    ) -> Option<ChildTerm> {
+        let joint = &model.joints[c];
+        let limits = todo.iter().find(|(j, _)| *j == c)?.1;
+        let p = trial.imu(&joint.proximal)?;
+        let d = trial.imu(&joint.distal)?;
+        let nd = Vector3::from(fits.hinge.segment_axes().1);
+        let windows = (windows.iter().zip(&fits.axes))
+            .map(|(w, axes)| {
+                let stride = w.len().div_ceil(CHILD_TERM_SAMPLES).max(1);
+                let rm = (w.first..w.end)
+                    .step_by(stride)
+                    .map(|i| p.orientation[i].inverse() * d.orientation[i])
+                    .collect();
+                let sd = axes
+                    .distal
+                    .map_or(Quat::identity(), |b| AxisFamily::new(&nd, &b).swing());
+                (rm, sd)
+            })
+            .collect();
+        Some(ChildTerm { windows, limits })
+    }
+
+    /// The joint's limit cost in window `k` with its proximal IMU corrected by
+    /// `c` (degrees, as the window cost without its size term).
+    fn eval(&self, k: usize, c: &Quat) -> f64 {
+        let (rm, sd) = &self.windows[k];
+        let ci = c.inverse();
+        let rt: Vec<Quat> = rm.iter().map(|m| ci * m * sd).collect();
+        WindowCost::new(&rt, &self.limits, 0.0).eval(&Quat::identity())
+    }
 }
 
 fn axis_families(
@@ -631,6 +719,7 @@ fn axis_families(
     todo: &[(usize, JointLimits)],
     hinges: &HashMap<usize, HingeFits>,
     k: usize,
+    lambda1: f64,
 ) -> Option<Families> {
     let own = hinges.get(&k);
     let child = todo
@@ -658,9 +747,18 @@ fn axis_families(
     if per_window.iter().all(Option::is_none) {
         return None;
     }
+    let two_axes = |f: &HingeFits| matches!(f.hinge, crate::model::Hinge::Two { .. });
+    let two_axis_child = child.filter(|c| from_child && two_axes(&hinges[c]));
+    let turn_weight = if own.is_some_and(two_axes) || two_axis_child.is_some() {
+        lambda1 * TWO_AXIS_TURN_WEIGHT
+    } else {
+        lambda1
+    };
     Some(Families {
         per_window,
         from_child: from_child.then(|| model.joints[child.expect("found")].name.clone()),
+        two_axis_child,
+        turn_weight,
     })
 }
 
@@ -674,7 +772,7 @@ fn turn_uncorrected_proximal(
     todo: &[(usize, JointLimits)],
     k: usize,
     hinges: &mut HashMap<usize, HingeFits>,
-    windows: &[Window],
+    (windows, lambda1): (&[Window], f64),
 ) {
     let joint = &model.joints[k];
     let Some(fits) = hinges.get_mut(&k) else {
@@ -687,10 +785,24 @@ fn turn_uncorrected_proximal(
         return;
     }
     let np = Vector3::from(fits.hinge.segment_axes().0);
-    let qs: Vec<Quat> = (fits.axes.iter())
-        .map(|a| {
-            a.proximal
-                .map_or(Quat::identity(), |a| AxisFamily::new(&np, &a).swing())
+    // A two-axis hinge's own limits decide the turn about its proximal axis
+    // (see `ChildTerm`); a one-axis hinge's turn is the distal IMU's to take.
+    let term = matches!(fits.hinge, crate::model::Hinge::Two { .. })
+        .then(|| ChildTerm::new(trial, model, todo, fits, k, windows))
+        .flatten();
+    let qs: Vec<Quat> = (fits.axes.iter().enumerate())
+        .map(|(w, a)| {
+            a.proximal.map_or(Quat::identity(), |a| {
+                let family = AxisFamily::new(&np, &a);
+                match &term {
+                    Some(t) => {
+                        let weight = lambda1 * TWO_AXIS_TURN_WEIGHT;
+                        let cost = |c: &Quat, phi: f64| t.eval(w, c) + weight * phi.abs();
+                        hinge::minimise_about_axis(&cost, &family).c
+                    }
+                    None => family.swing(),
+                }
+            })
         })
         .collect();
     let centres: Vec<f64> = windows.iter().map(|w| w.centre_s).collect();
@@ -715,7 +827,7 @@ fn solve_windows_with_axes(
     (time_s, measured): (&[f64], &[Quat]),
     windows: &[Window],
     (limits, lambda1, solver): (&JointLimits, f64, Solver),
-    families: &[Option<AxisFamily>],
+    (families, child, turn_weight): (&[Option<AxisFamily>], Option<&ChildTerm>, f64),
     control: &RunControl,
     progress: &(dyn Fn() + Sync),
 ) -> Result<JointSolution, Cancelled> {
@@ -741,8 +853,13 @@ fn solve_windows_with_axes(
             }
             let cost = WindowCost::new(&measured[w.first..w.end], limits, lambda1);
             // The size term counts the turn about the axis only (see `hinge`).
-            let about_axis =
-                |c: &Quat, phi: f64| cost.eval(c) - lambda1 * angle_deg(c) + lambda1 * phi.abs();
+            // A two-axis hinge below adds its limits on the turn about its
+            // proximal axis (see `ChildTerm`).
+            let about_axis = |c: &Quat, phi: f64| {
+                cost.eval(c) - lambda1 * angle_deg(c)
+                    + turn_weight * phi.abs()
+                    + child.map_or(0.0, |t| t.eval(k, c))
+            };
             let s = hinge::minimise_about_axis(&about_axis, family);
             if free.is_none() {
                 progress();

@@ -260,7 +260,7 @@ fn single_axis(
 }
 
 /// Two-axis hinge: the Mueller estimate, starting from the segment axes
-/// `nominal` (proximal, distal).
+/// `nominal` (proximal, distal), refined by [`refine_two_axes`].
 fn two_axes(
     rm: &[Quat],
     rates: &[Vector3<f64>],
@@ -271,7 +271,157 @@ fn two_axes(
         ..MuellerOptions::default()
     };
     let fit = estimate_axes(rm, rates, nominal, &opts)?;
-    Some((fit.proximal_axis.into(), fit.distal_axis.into(), None))
+    let (mut a, mut b) = refine_two_axes(
+        rm,
+        rates,
+        (fit.proximal_axis.into(), fit.distal_axis.into()),
+        &opts,
+    );
+    if a.dot(&nominal.0) < 0.0 {
+        a = -a;
+    }
+    if b.dot(&nominal.1) < 0.0 {
+        b = -b;
+    }
+    Some((a, b, None))
+}
+
+/// Most samples the two-axis refinement takes (evenly spaced).
+const REFINE_MAX_SAMPLES: usize = 3000;
+/// Weight of the held angle's prior in the two-axis refinement, relative to
+/// the RMS relative rate: the model's two segment axes are perpendicular, so
+/// `a . Rm_k b` is the sine of the held angle, which the prior pulls to zero.
+pub const HELD_ANGLE_WEIGHT: f64 = 0.3;
+/// Levenberg-Marquardt iterations of the two-axis refinement.
+const REFINE_ITERATIONS: usize = 60;
+
+/// Unit vectors spanning the plane perpendicular to the unit vector `a`.
+fn tangent_basis(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let helper = if a.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let u = helper.cross(a).normalize();
+    (u, a.cross(&u))
+}
+
+/// The two-axis constraint's residuals: the component of each relative rate
+/// `w_k` (rad/s, proximal frame) normal to the plane of `a` and `Rm_k b`.
+fn plane_residuals(
+    samples: &[(Matrix3<f64>, Vector3<f64>)],
+    held_weight: f64,
+    a: &Vector3<f64>,
+    b: &Vector3<f64>,
+    out: &mut Vec<f64>,
+) {
+    out.clear();
+    out.extend(samples.iter().map(|(m, w)| {
+        let n = a.cross(&(m * b));
+        let len = n.norm();
+        if len > 1e-9 {
+            w.dot(&n) / len
+        } else {
+            0.0
+        }
+    }));
+    out.extend(samples.iter().map(|(m, _)| held_weight * a.dot(&(m * b))));
+}
+
+/// Refines a two-axis hinge's axes `start` (proximal frame, distal frame) by
+/// Gauss-Newton with Levenberg-Marquardt damping over the four tangent
+/// angles of the two unit axes, minimising `sum_k (w_k . n_k)^2` with
+/// `n_k` the unit normal of the plane of `a` and `Rm_k b`: every relative rate
+/// of a two-axis joint lies in that plane (Seel et al. 2014, Mueller et al.
+/// 2017). Unlike Mueller's `J`, the residuals are not divided by `|w_k|`:
+/// a small turn about the third axis (the elbow's Y, which the model holds
+/// constant) is a zero-mean rate that the sum averages out, and dividing by
+/// `|w_k|` would give the samples where it dominates (the joint slowing down
+/// about both hinge axes) the largest say. Samples under the minimum rate
+/// are left out as for Mueller's estimate.
+pub fn refine_two_axes(
+    rm: &[Quat],
+    rates: &[Vector3<f64>],
+    start: (Vector3<f64>, Vector3<f64>),
+    opts: &MuellerOptions,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let min_rate = opts.min_rate_deg_s.to_radians();
+    let moving: Vec<usize> = (0..rm.len().min(rates.len()))
+        .filter(|&k| rates[k].norm() > min_rate)
+        .collect();
+    let (mut a, mut b) = (start.0.normalize(), start.1.normalize());
+    if moving.len() < 10 {
+        return (a, b);
+    }
+    let stride = moving.len().div_ceil(REFINE_MAX_SAMPLES);
+    let samples: Vec<(Matrix3<f64>, Vector3<f64>)> = (moving.iter().step_by(stride))
+        .map(|&k| (*rm[k].to_rotation_matrix().matrix(), rates[k]))
+        .collect();
+    // The held angle's prior: `a . Rm b` (the cosine of the angle between the
+    // axes, zero when the held angle is) as one residual per sample, scaled to
+    // the RMS rate.
+    let rms_rate =
+        (samples.iter().map(|(_, w)| w.norm_squared()).sum::<f64>() / samples.len() as f64).sqrt();
+    let held_weight = HELD_ANGLE_WEIGHT * rms_rate;
+    let step = |a: &Vector3<f64>, b: &Vector3<f64>, d: &nalgebra::Vector4<f64>| {
+        let (ua, va) = tangent_basis(a);
+        let (ub, vb) = tangent_basis(b);
+        (
+            (a + ua * d[0] + va * d[1]).normalize(),
+            (b + ub * d[2] + vb * d[3]).normalize(),
+        )
+    };
+    let (mut r, mut moved) = (Vec::new(), Vec::new());
+    plane_residuals(&samples, held_weight, &a, &b, &mut r);
+    let sum_sq = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
+    let mut f = sum_sq(&r);
+    let mut mu = 1e-3;
+    let h = 1e-7;
+    for _ in 0..REFINE_ITERATIONS {
+        // Forward-difference Jacobian, one column per tangent angle.
+        let mut jac = vec![nalgebra::Vector4::<f64>::zeros(); r.len()];
+        for p in 0..4 {
+            let mut d = nalgebra::Vector4::zeros();
+            d[p] = h;
+            let (a2, b2) = step(&a, &b, &d);
+            plane_residuals(&samples, held_weight, &a2, &b2, &mut moved);
+            for (j, (m, r0)) in jac.iter_mut().zip(moved.iter().zip(&r)) {
+                j[p] = (m - r0) / h;
+            }
+        }
+        let mut jtj = nalgebra::Matrix4::<f64>::zeros();
+        let mut jtr = nalgebra::Vector4::<f64>::zeros();
+        for (j, r0) in jac.iter().zip(&r) {
+            jtj += j * j.transpose();
+            jtr += j * *r0;
+        }
+        let mut improved = false;
+        for _ in 0..30 {
+            let mut m = jtj;
+            for p in 0..4 {
+                m[(p, p)] += mu * jtj[(p, p)] + 1e-12;
+            }
+            let Some(inv) = m.try_inverse() else {
+                mu *= 10.0;
+                continue;
+            };
+            let (a2, b2) = step(&a, &b, &(-(inv * jtr)));
+            plane_residuals(&samples, held_weight, &a2, &b2, &mut moved);
+            let f2 = sum_sq(&moved);
+            if f2 < f {
+                improved = f - f2 > 1e-12 * f;
+                (a, b, f) = (a2, b2, f2);
+                std::mem::swap(&mut r, &mut moved);
+                mu = (mu * 0.3).max(1e-9);
+                break;
+            }
+            mu *= 10.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    (a, b)
 }
 
 /// Turn of `q` about the unit axis `u` (its twist), degrees in [-180, 180).
@@ -487,6 +637,43 @@ mod tests {
             .as_deref()
             .unwrap()
             .contains("hardly moved"));
+    }
+
+    #[test]
+    fn two_axes_are_refined_past_a_small_turn_about_the_third() {
+        // An elbow (pronation Z in the upper arm, flexion X in the forearm)
+        // whose Y also turns +-5 deg with zero mean, both sensors tilted.
+        let ma = quat_axis_angle_deg([1.0, 1.0, 0.0], 20.0);
+        let mb = quat_axis_angle_deg([0.0, 1.0, -1.0], 20.0);
+        let t: Vec<f64> = (0..3000).map(|i| f64::from(i) * 0.02).collect();
+        let rm: Vec<Quat> = (t.iter())
+            .map(|&s| {
+                let flex = 70.0 + 60.0 * (1.3 * s).sin();
+                let pro = 25.0 * (0.7 * s + 1.0).sin();
+                let y = 5.0 * (2.3 * s + 0.4).sin();
+                ma.inverse() * quat_from_euler_zyx_deg([flex, y, pro]) * mb
+            })
+            .collect();
+        let rates = rates_from_orientations(&t, &rm, 0.05);
+        let (want_a, want_b) = (ma.inverse() * Vector3::z(), mb.inverse() * Vector3::x());
+        let opts = MuellerOptions::default();
+        let (a, b) = refine_two_axes(&rm, &rates, (Vector3::z(), Vector3::x()), &opts);
+        let (ea, eb) = (
+            angle_between_axes_deg(&a, &want_a),
+            angle_between_axes_deg(&b, &want_b),
+        );
+        assert!(ea < 1.0 && eb < 1.0, "{ea} / {eb}");
+        // The window estimate the variant uses gives the same axes.
+        let (rec, axes) = estimate_window(
+            Hinge::two_axes_holding(crate::model::Axis::Y),
+            30.0,
+            &rm,
+            &rates,
+        );
+        assert!(rec.fallback.is_none(), "{rec:?}");
+        let ap = axes.proximal.unwrap();
+        assert!(angle_between_axes_deg(&ap, &want_a) < 1.0);
+        assert!(angle_between_axes_deg(&axes.distal.unwrap(), &want_b) < 1.0);
     }
 
     #[test]
