@@ -336,6 +336,8 @@ impl LimitTerms {
     /// [`LimitTerms::excursion`] takes them) whose principal triplet is not
     /// inside all three ranges, written to `out`; returns their number. The
     /// others add nothing to the excursion or its gradient.
+    // Indexed over the block's parallel arrays, as the loops that fill them.
+    #[allow(clippy::needless_range_loop)]
     #[inline(always)]
     pub(super) fn outside(
         &self,
