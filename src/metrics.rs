@@ -37,6 +37,15 @@ pub fn joint_angles(trial: &Trial, joint: &Joint) -> Option<Vec<[f64; 3]>> {
     )
 }
 
+/// [`joint_angles`] of every joint of `model` (none where the trial lacks
+/// one of its IMUs), in the model's order; the joints in parallel.
+pub fn model_joint_angles(trial: &Trial, model: &Model) -> Vec<Option<Vec<[f64; 3]>>> {
+    use rayon::prelude::*;
+    (model.joints.par_iter())
+        .map(|joint| joint_angles(trial, joint))
+        .collect()
+}
+
 /// Excursion figures of one joint (Tables 4-1, 4-2 and Figure 4-20).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ExcursionFigures {

@@ -144,6 +144,18 @@ impl ArcRange {
         beyond_slope(a, self.lo, self.hi)
     }
 
+    /// [`ArcRange::inside`] without branches on the sample (bitwise tests),
+    /// for a pass over a block that the compiler keeps free of jumps.
+    #[inline(always)]
+    fn inside_flat(&self, s: f64, c: f64) -> bool {
+        let after_lo = (self.lo_dir[0] * s - self.lo_dir[1] * c) >= 0.0;
+        let before_hi = (c * self.hi_dir[1] - s * self.hi_dir[0]) >= 0.0;
+        let either = after_lo | before_hi;
+        let both = after_lo & before_hi;
+        let inside = (self.wide & either) | (!self.wide & both);
+        self.full | (inside & ((s != 0.0) | (c != 0.0)))
+    }
+
     #[inline(always)]
     fn inside(&self, s: f64, c: f64) -> bool {
         if self.full {
@@ -206,6 +218,12 @@ impl PitchRange {
     #[inline(always)]
     fn inside(&self, r20: f64) -> bool {
         r20 <= self.r20_max && r20 >= self.r20_min
+    }
+
+    /// [`PitchRange::inside`] without branches (bitwise tests).
+    #[inline(always)]
+    fn inside_flat(&self, r20: f64) -> bool {
+        (r20 <= self.r20_max) & (r20 >= self.r20_min)
     }
 
     /// As [`PitchRange::excursion`], with the slope in theta.
@@ -303,6 +321,38 @@ impl LimitTerms {
         }
     }
 
+    /// True when the principal Z-Y-X triplet of the rotation with entries
+    /// `[r00, r10, r20, r21, r22]` lies inside all three ranges: the sample
+    /// then adds nothing to the excursion or its gradient. Without branches,
+    /// so a block's samples are sorted into inside and outside in one pass
+    /// free of mispredicted jumps.
+    #[inline(always)]
+    fn inside_flat(&self, [r00, r10, r20, r21, r22]: [f64; 5]) -> bool {
+        self.x.inside_flat(r21, r22) & self.y.inside_flat(r20) & self.z.inside_flat(r10, r00)
+    }
+
+    /// The indices (in order) of the first `len` samples of a block of
+    /// entries `e` (`[r00, r10, r20, r21, r22]` per sample, as
+    /// [`LimitTerms::excursion`] takes them) whose principal triplet is not
+    /// inside all three ranges, written to `out`; returns their number. The
+    /// others add nothing to the excursion or its gradient.
+    // Indexed over the block's parallel arrays, as the loops that fill them.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    pub(super) fn outside(
+        &self,
+        e: &[[f64; BLOCK]; 5],
+        len: usize,
+        out: &mut [u8; BLOCK],
+    ) -> usize {
+        let mut m = 0;
+        for i in 0..len.min(BLOCK) {
+            out[m] = i as u8;
+            m += usize::from(!self.inside_flat([e[0][i], e[1][i], e[2][i], e[3][i], e[4][i]]));
+        }
+        m
+    }
+
     /// `Ex + Ey + Ez` (degrees) of the Z-Y-X angles of a rotation, from its
     /// entries `[r00, r10, r20, r21, r22]`; where the Y range reaches beyond
     /// +-90, of the triplet the limits read (the smaller total of the two;
@@ -335,14 +385,25 @@ impl LimitTerms {
     /// as `phi`, `-theta`, `psi`).
     #[inline(always)]
     fn slopes(&self, [r00, r10, r20, r21, r22]: [f64; 5]) -> [(f64, f64); 3] {
+        let Some(other) = &self.other else {
+            return [
+                self.x.excursion_slope(r21, r22),
+                self.y.excursion_slope(r20),
+                self.z.excursion_slope(r10, r00),
+            ];
+        };
+        // Either triplet inside its ranges: no excursion, and no
+        // trigonometry for the other (the same values as below).
+        if (self.x.inside(r21, r22) && self.y.inside(r20) && self.z.inside(r10, r00))
+            || (self.x.inside(-r21, -r22) && other.inside(r20) && self.z.inside(-r10, -r00))
+        {
+            return [(0.0, 0.0); 3];
+        }
         let principal = [
             self.x.excursion_slope(r21, r22),
             self.y.excursion_slope(r20),
             self.z.excursion_slope(r10, r00),
         ];
-        let Some(other) = &self.other else {
-            return principal;
-        };
         let p = principal[0].0 + principal[1].0 + principal[2].0;
         if p == 0.0 {
             return principal;
@@ -541,6 +602,8 @@ impl Samples {
 /// Samples evaluated together: the matrix products of a block are formed in
 /// one loop the compiler can vectorise, then the range tests run over them.
 pub(super) const BLOCK: usize = 64;
+// A block's sample indices are held as `u8`.
+const _: () = assert!(BLOCK <= 256);
 
 /// The cost of one joint over one window, prepared for many evaluations.
 #[derive(Debug, Clone)]
@@ -666,7 +729,12 @@ impl WindowCost {
                 e[3][i] = r2.0[i] * col1[0] + r2.1[i] * col1[1] + r2.2[i] * col1[2];
                 e[4][i] = r2.0[i] * col2[0] + r2.1[i] * col2[1] + r2.2[i] * col2[2];
             }
-            for i in 0..len {
+            // The samples inside every range add nothing (exactly: no term,
+            // no gradient): only the others, in order, take the slow path.
+            let mut outside = [0u8; BLOCK];
+            let m = self.terms.outside(&e, len, &mut outside);
+            for &i in &outside[..m] {
+                let i = usize::from(i);
                 let entries = [e[0][i], e[1][i], e[2][i], e[3][i], e[4][i]];
                 sum += match grad {
                     Some(_) => self.terms.excursion_grad(entries, &mut g),

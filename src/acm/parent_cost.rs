@@ -149,7 +149,11 @@ impl ParentCost {
                 e[3][i] = row2[0] * c1.0[i] + row2[1] * c1.1[i] + row2[2] * c1.2[i];
                 e[4][i] = row2[0] * c2.0[i] + row2[1] * c2.1[i] + row2[2] * c2.2[i];
             }
-            for i in 0..len {
+            // Samples inside every range add nothing: only the others, in order.
+            let mut outside = [0u8; BLOCK];
+            let m = self.terms.outside(&e, len, &mut outside);
+            for &i in &outside[..m] {
+                let i = usize::from(i);
                 let entries = [e[0][i], e[1][i], e[2][i], e[3][i], e[4][i]];
                 if grad.is_none() {
                     sum += self.terms.excursion(entries);

@@ -42,7 +42,7 @@ use crate::calibration::AppliedCalibration;
 use crate::correct::{correct_trial, recorrect};
 use crate::limits::{LimitTable, Settings};
 use crate::model::Model;
-use crate::pose::convention::check_conventions;
+use crate::pose::convention::check_conventions_of;
 use crate::pose::{calibrate, PoseCalibration, PoseError, PoseRecord};
 use crate::report::{ReportInput, TrialReport};
 use crate::sidecar::{default_output, SaveRequest};
@@ -185,9 +185,12 @@ pub fn prepare(
         }
         None => (trial, None),
     };
-    let checks = check_conventions(&trial, setup.model, setup.limits, pose.is_some());
+    // Both checks read the same joint angles: computed once.
+    let angles = crate::metrics::model_joint_angles(&trial, setup.model);
+    let checks = check_conventions_of(&angles, setup.model, setup.limits, pose.is_some());
     trial.warnings.extend(checks);
-    let centroids = crate::pose::centroid_check::check_centroids(&trial, setup.model, setup.limits);
+    let centroids =
+        crate::pose::centroid_check::check_centroids_of(&angles, setup.model, setup.limits);
     trial.warnings.extend(centroids);
     Ok(Prepared {
         trial,

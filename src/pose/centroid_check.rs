@@ -11,7 +11,7 @@
 //! naming the joint and suggesting centroids from the lab's own clean trials.
 
 use crate::limits::LimitTable;
-use crate::metrics::joint_angles;
+use crate::metrics::model_joint_angles;
 use crate::model::{Axis, Model};
 use crate::rotation::wrap180;
 use crate::trial::Trial;
@@ -36,15 +36,25 @@ pub fn is_centroid_warning(warning: &str) -> bool {
 /// centroid on some axis, for the joints whose centroid term is on
 /// (`lambda2 > 0`). Angles in the table's convention, degrees.
 pub fn check_centroids(trial: &Trial, model: &Model, limits: &LimitTable) -> Vec<String> {
+    check_centroids_of(&model_joint_angles(trial, model), model, limits)
+}
+
+/// As [`check_centroids`], from the trial's joint angles
+/// ([`model_joint_angles`]: one entry per joint of `model`, in its order).
+pub fn check_centroids_of(
+    angles: &[Option<Vec<[f64; 3]>>],
+    model: &Model,
+    limits: &LimitTable,
+) -> Vec<String> {
     let mut out = Vec::new();
-    for joint in &model.joints {
+    for (joint, angles) in model.joints.iter().zip(angles) {
         let Some(lim) = limits.joint_limits(&joint.name, &joint.kind, true) else {
             continue;
         };
         let (Some(centroid), true) = (lim.centroid_deg, lim.lambda2 > 0.0) else {
             continue;
         };
-        let Some(angles) = joint_angles(trial, joint) else {
+        let Some(angles) = angles else {
             continue;
         };
         if angles.len() < 10 {

@@ -29,8 +29,8 @@
 //! avoids lies at Y = +-90 deg, beyond the motions these checks look at.
 
 use crate::limits::LimitTable;
-use crate::metrics::joint_angles;
-use crate::model::{Axis, Model};
+use crate::metrics::model_joint_angles;
+use crate::model::{Axis, Joint, Model};
 use crate::trial::Trial;
 
 /// Motion smaller than this (degrees, either way) says nothing about the sense.
@@ -66,87 +66,109 @@ pub fn check_conventions(
     limits: &LimitTable,
     calibrated: bool,
 ) -> Vec<String> {
+    check_conventions_of(&model_joint_angles(trial, model), model, limits, calibrated)
+}
+
+/// As [`check_conventions`], from the trial's joint angles
+/// ([`model_joint_angles`]: one entry per joint of `model`, in its order).
+/// The joints are checked in parallel; the warnings come in the model's order.
+pub fn check_conventions_of(
+    angles: &[Option<Vec<[f64; 3]>>],
+    model: &Model,
+    limits: &LimitTable,
+    calibrated: bool,
+) -> Vec<String> {
+    use rayon::prelude::*;
+    let per_joint: Vec<Vec<String>> = (model.joints.par_iter().zip(angles))
+        .map(|(joint, angles)| joint_warnings(joint, angles.as_deref(), limits, calibrated))
+        .collect();
+    per_joint.concat()
+}
+
+/// [`check_conventions`]' warnings about one joint with angles `angles`.
+fn joint_warnings(
+    joint: &Joint,
+    angles: Option<&[[f64; 3]]>,
+    limits: &LimitTable,
+    calibrated: bool,
+) -> Vec<String> {
     let mut out = Vec::new();
-    for joint in &model.joints {
-        let (Some(angles), Some(lim)) = (
-            joint_angles(trial, joint),
-            limits.joint_limits(&joint.name, &joint.kind, false),
-        ) else {
+    let (Some(angles), Some(lim)) = (angles, limits.joint_limits(&joint.name, &joint.kind, false))
+    else {
+        return out;
+    };
+    if angles.len() < 10 {
+        return out;
+    }
+    let mut reach = [[0.0f64; 2]; 3];
+    for axis in Axis::ALL {
+        let k = axis.index();
+        let [lo, hi] = lim.range_deg[k];
+        let mut v: Vec<f64> = angles.iter().map(|a| a[k]).collect();
+        let n = v.len() as f64;
+        // Within 1e-9 deg of a limit is on it (rounding of a joint held there).
+        let below = v.iter().filter(|&&x| x < lo - 1e-9).count() as f64 / n;
+        let above = v.iter().filter(|&&x| x > hi + 1e-9).count() as f64 / n;
+        let (p2, p98) = (percentile(&mut v, 0.02), percentile(&mut v, 0.98));
+        reach[k] = [(-p2).max(0.0), p98.max(0.0)];
+        let name = format!("{} {}", joint.name, axis.name());
+        if below > OFFSET_SHARE && p98 < hi {
+            out.push(format!(
+                "{name}: {:.0}% of the samples are below the table's {lo} deg (98% below {p98:.1}): the angles look offset; likely the calibration pose differs from the model's default pose, or the trial is not pose-calibrated (--pose-calibration)",
+                100.0 * below
+            ));
+        } else if above > OFFSET_SHARE && p2 > lo {
+            out.push(format!(
+                "{name}: {:.0}% of the samples are above the table's {hi} deg (98% above {p2:.1}): the angles look offset; likely the calibration pose differs from the model's default pose, or the trial is not pose-calibrated (--pose-calibration)",
+                100.0 * above
+            ));
+        }
+        let Some(sense) = expected_sense(lo, hi).filter(|_| calibrated) else {
             continue;
         };
-        if angles.len() < 10 {
-            continue;
-        }
-        let mut reach = [[0.0f64; 2]; 3];
-        for axis in Axis::ALL {
-            let k = axis.index();
-            let [lo, hi] = lim.range_deg[k];
-            let mut v: Vec<f64> = angles.iter().map(|a| a[k]).collect();
-            let n = v.len() as f64;
-            // Within 1e-9 deg of a limit is on it (rounding of a joint held there).
-            let below = v.iter().filter(|&&x| x < lo - 1e-9).count() as f64 / n;
-            let above = v.iter().filter(|&&x| x > hi + 1e-9).count() as f64 / n;
-            let (p2, p98) = (percentile(&mut v, 0.02), percentile(&mut v, 0.98));
-            reach[k] = [(-p2).max(0.0), p98.max(0.0)];
-            let name = format!("{} {}", joint.name, axis.name());
-            if below > OFFSET_SHARE && p98 < hi {
-                out.push(format!(
-                    "{name}: {:.0}% of the samples are below the table's {lo} deg (98% below {p98:.1}): the angles look offset; likely the calibration pose differs from the model's default pose, or the trial is not pose-calibrated (--pose-calibration)",
-                    100.0 * below
-                ));
-            } else if above > OFFSET_SHARE && p2 > lo {
-                out.push(format!(
-                    "{name}: {:.0}% of the samples are above the table's {hi} deg (98% above {p2:.1}): the angles look offset; likely the calibration pose differs from the model's default pose, or the trial is not pose-calibrated (--pose-calibration)",
-                    100.0 * above
-                ));
-            }
-            let Some(sense) = expected_sense(lo, hi).filter(|_| calibrated) else {
-                continue;
-            };
-            let (expected, other) = if sense > 0.0 {
-                (reach[k][1], reach[k][0])
+        let (expected, other) = if sense > 0.0 {
+            (reach[k][1], reach[k][0])
+        } else {
+            (reach[k][0], reach[k][1])
+        };
+        if other >= MIN_MOTION_DEG && other > MIRROR_RATIO * expected {
+            let way = |s: f64| if s > 0.0 { "positive" } else { "negative" };
+            let cause = if joint.kind == "knee" {
+                "the heading of the pose calibration is likely 180 deg off: check --base-forward (the base IMU's forward axis in the pose)".to_string()
             } else {
-                (reach[k][0], reach[k][1])
+                format!(
+                    "the model's angle_axes for {} likely count this axis the other way, or its pose is not the one held (or the heading is off: --base-forward)",
+                    joint.name
+                )
             };
-            if other >= MIN_MOTION_DEG && other > MIRROR_RATIO * expected {
-                let way = |s: f64| if s > 0.0 { "positive" } else { "negative" };
-                let cause = if joint.kind == "knee" {
-                    "the heading of the pose calibration is likely 180 deg off: check --base-forward (the base IMU's forward axis in the pose)".to_string()
-                } else {
-                    format!(
-                        "the model's angle_axes for {} likely count this axis the other way, or its pose is not the one held (or the heading is off: --base-forward)",
-                        joint.name
-                    )
-                };
+            out.push(format!(
+                "{name}: moves {other:.1} deg {} but only {expected:.1} deg {} from the calibration pose, while the table ({lo}..{hi} deg) expects the {} sense: the angles look mirrored; {cause}",
+                way(-sense),
+                way(sense),
+                way(sense)
+            ));
+        }
+    }
+    if !calibrated {
+        return out;
+    }
+    // A narrow axis that moves more than the flexion axis.
+    let flexion = Axis::ALL.into_iter().find(|a| {
+        let [lo, hi] = lim.range_deg[a.index()];
+        expected_sense(lo, hi).is_some()
+    });
+    if let Some(f) = flexion {
+        let flex_motion = reach[f.index()][0].max(reach[f.index()][1]);
+        for axis in Axis::ALL.into_iter().filter(|a| *a != f) {
+            let [lo, hi] = lim.range_deg[axis.index()];
+            let motion = reach[axis.index()][0].max(reach[axis.index()][1]);
+            if hi - lo <= 20.0 && motion >= 2.0 * MIN_MOTION_DEG && motion > 2.0 * flex_motion {
                 out.push(format!(
-                    "{name}: moves {other:.1} deg {} but only {expected:.1} deg {} from the calibration pose, while the table ({lo}..{hi} deg) expects the {} sense: the angles look mirrored; {cause}",
-                    way(-sense),
-                    way(sense),
-                    way(sense)
+                    "{} {}: moves {motion:.1} deg, more than twice the {} axis ({flex_motion:.1} deg) the table lets move: the axes look swapped; likely the heading of the pose calibration is 90 deg off (--base-forward)",
+                    joint.name,
+                    axis.name(),
+                    f.name()
                 ));
-            }
-        }
-        if !calibrated {
-            continue;
-        }
-        // A narrow axis that moves more than the flexion axis.
-        let flexion = Axis::ALL.into_iter().find(|a| {
-            let [lo, hi] = lim.range_deg[a.index()];
-            expected_sense(lo, hi).is_some()
-        });
-        if let Some(f) = flexion {
-            let flex_motion = reach[f.index()][0].max(reach[f.index()][1]);
-            for axis in Axis::ALL.into_iter().filter(|a| *a != f) {
-                let [lo, hi] = lim.range_deg[axis.index()];
-                let motion = reach[axis.index()][0].max(reach[axis.index()][1]);
-                if hi - lo <= 20.0 && motion >= 2.0 * MIN_MOTION_DEG && motion > 2.0 * flex_motion {
-                    out.push(format!(
-                        "{} {}: moves {motion:.1} deg, more than twice the {} axis ({flex_motion:.1} deg) the table lets move: the axes look swapped; likely the heading of the pose calibration is 90 deg off (--base-forward)",
-                        joint.name,
-                        axis.name(),
-                        f.name()
-                    ));
-                }
             }
         }
     }
