@@ -19,6 +19,11 @@ fn open_trial(app: &mut App, file: &str) {
     assert!(app.open_entry().unwrap().running.is_none());
 }
 
+/// Puts the cursor on `joint` of the open trial.
+fn select_joint(app: &mut App, joint: &str) {
+    app.joint = app.open_joints().iter().position(|j| j == joint).unwrap();
+}
+
 /// Cells of a colour in columns `[x0, x1)` below the title row.
 fn cells_of(app: &App, colour: Color, x0: u16, x1: u16) -> usize {
     let t = terminal(app, 120, 40);
@@ -57,11 +62,7 @@ fn scatter_and_globe_colour_the_classes_raw_beside_corrected() {
     // The shoulder: rotation about Y, flexion X, abduction Z.
     let mut app = fx.app();
     open_trial(&mut app, "fb.csv.gz");
-    app.joint = app
-        .open_joints()
-        .iter()
-        .position(|j| j == "l_shoulder")
-        .unwrap();
+    select_joint(&mut app, "l_shoulder");
     keys(&mut app, "o");
     snap("globe_shoulder", &app);
     keys(&mut app, "x");
@@ -111,11 +112,7 @@ fn globe_draws_a_swing_twist_region() {
     // The shoulder (twist about Y): the region's edge away from the band's.
     let mut app = fx.app();
     open_trial(&mut app, "fb.csv.gz");
-    app.joint = app
-        .open_joints()
-        .iter()
-        .position(|j| j == "l_shoulder")
-        .unwrap();
+    select_joint(&mut app, "l_shoulder");
     keys(&mut app, "o");
     assert!(edge_cells(&app, 0, 60) > 10);
     snap_at("globe_swing_twist_shoulder", &app, 120, 40);
@@ -132,11 +129,7 @@ fn applied_correction_marks_window_centres() {
     write_trial(&sim.trial, &dir.join("long.csv"), TrialFormat::QuatCsv).unwrap();
     let mut app = fx.app();
     open_trial(&mut app, "long.csv");
-    app.joint = app
-        .open_joints()
-        .iter()
-        .position(|j| j == "l_knee")
-        .unwrap();
+    select_joint(&mut app, "l_knee");
     keys(&mut app, "a");
     assert_eq!(app.views.kind, ViewKind::Applied);
     let text = format!("{}", terminal(&app, 120, 40).backend());
