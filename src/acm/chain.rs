@@ -30,7 +30,7 @@ use super::{
 use crate::baselines;
 use crate::limits::{JointLimits, LimitTable, Settings};
 use crate::model::{Joint, Model};
-use crate::rotation::{angle_deg, canonical, quat_from_wxyz, wxyz, Quat};
+use crate::rotation::{angle_deg, canonical, quat_from_wxyz, wrap180, wxyz, Quat};
 use crate::trial::Trial;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -843,6 +843,18 @@ fn solve_windows_with_axes(
     } else {
         None
     };
+    // A two-axis hinge's turn (lighter size term): held towards the turn the
+    // windows ask for together (see `pooled_turn`).
+    let held_deg = if turn_weight < lambda1 {
+        pooled_turn(
+            (measured, windows),
+            families,
+            child,
+            (limits, lambda1, turn_weight),
+        )
+    } else {
+        0.0
+    };
     let solutions: Vec<WindowSolution> = (windows.par_iter().zip(families).enumerate())
         .map(|(k, (w, family))| {
             let Some(family) = family else {
@@ -852,12 +864,12 @@ fn solve_windows_with_axes(
                 return Err(Cancelled);
             }
             let cost = WindowCost::new(&measured[w.first..w.end], limits, lambda1);
-            // The size term counts the turn about the axis only (see `hinge`).
-            // A two-axis hinge below adds its limits on the turn about its
-            // proximal axis (see `ChildTerm`).
+            // The size term counts the turn about the axis only (see `hinge`),
+            // from the held turn. A two-axis hinge below adds its limits on
+            // the turn about its proximal axis (see `ChildTerm`).
             let about_axis = |c: &Quat, phi: f64| {
                 cost.eval(c) - lambda1 * angle_deg(c)
-                    + turn_weight * phi.abs()
+                    + turn_weight * wrap180(phi - held_deg).abs()
                     + child.map_or(0.0, |t| t.eval(k, c))
             };
             let s = hinge::minimise_about_axis(&about_axis, family);
@@ -886,6 +898,43 @@ fn solve_windows_with_axes(
         series: correction_series(time_s, &centres, &qs),
         windows: solutions,
     })
+}
+
+/// The turn about a two-axis hinge's axis (degrees) that the windows with an
+/// axis ask for together: the sum over them of the window cost (without its
+/// size term) and of the child's limits, at one turn for all, plus the size
+/// term of that turn once per window. A turn about a hinge axis moves one
+/// joint angle alone, so only the windows where that angle nears a limit see
+/// it; an IMU that sits still on its segment has the same turn in every
+/// window, which the windows that see it give the others (docs/method.md
+/// section 18). Each window is then held towards it by the size term.
+fn pooled_turn(
+    (measured, windows): (&[Quat], &[Window]),
+    families: &[Option<AxisFamily>],
+    child: Option<&ChildTerm>,
+    (limits, lambda1, turn_weight): (&JointLimits, f64, f64),
+) -> f64 {
+    let costs: Vec<(usize, WindowCost, &AxisFamily)> = (windows.iter().zip(families).enumerate())
+        .filter_map(|(k, (w, f))| {
+            let f = f.as_ref()?;
+            Some((
+                k,
+                WindowCost::new(&measured[w.first..w.end], limits, lambda1),
+                f,
+            ))
+        })
+        .collect();
+    let total = |phi: f64| -> f64 {
+        let parts: Vec<f64> = costs
+            .par_iter()
+            .map(|(k, cost, family)| {
+                let c = family.at(phi);
+                cost.eval(&c) - lambda1 * angle_deg(&c) + child.map_or(0.0, |t| t.eval(*k, &c))
+            })
+            .collect();
+        parts.iter().sum::<f64>() + turn_weight * costs.len() as f64 * wrap180(phi).abs()
+    };
+    hinge::minimise_turn(&total).0
 }
 
 fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &str) -> bool {

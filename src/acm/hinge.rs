@@ -533,8 +533,20 @@ pub struct AxisSolution {
 /// in the steps either side of the best (the first best on ties, so the
 /// result is deterministic).
 pub fn minimise_about_axis(cost: &dyn Fn(&Quat, f64) -> f64, family: &AxisFamily) -> AxisSolution {
+    let (phi, v, evaluations) = minimise_turn(&|phi: f64| cost(&family.at(phi), wrap180(phi)));
+    AxisSolution {
+        c: family.at(phi),
+        phi_deg: phi,
+        cost: v,
+        evaluations,
+    }
+}
+
+/// The turn `phi` (degrees, in (-180, 180]) minimising `f` over the whole
+/// circle: a scan every [`SCAN_STEP_DEG`], then a golden-section search
+/// around the scan's lowest point. Returns `(phi, f(phi), evaluations)`.
+pub fn minimise_turn(f: &dyn Fn(f64) -> f64) -> (f64, f64, usize) {
     let steps = (360.0 / SCAN_STEP_DEG).round() as usize;
-    let f = |phi: f64| cost(&family.at(phi), wrap180(phi));
     let mut best = (0.0, f(0.0));
     for k in 0..steps {
         let phi = -180.0 + k as f64 * SCAN_STEP_DEG;
@@ -569,13 +581,7 @@ pub fn minimise_about_axis(cost: &dyn Fn(&Quat, f64) -> f64, family: &AxisFamily
     let (phi, v) = [(x1, f1), (x2, f2)]
         .into_iter()
         .fold(best, |b, c| if c.1 < b.1 { c } else { b });
-    let phi = wrap180(phi);
-    AxisSolution {
-        c: family.at(phi),
-        phi_deg: phi,
-        cost: v,
-        evaluations,
-    }
+    (wrap180(phi), v, evaluations)
 }
 
 #[cfg(test)]
