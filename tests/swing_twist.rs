@@ -13,16 +13,15 @@ mod common;
 use acm_workbench::acm::cost::WindowCost;
 use acm_workbench::acm::heading_cost::HeadingCost;
 use acm_workbench::acm::parent_cost::ParentCost;
-use acm_workbench::acm::{Correction, RunControl, Variant};
-use acm_workbench::correct::correct_trial;
+use acm_workbench::acm::Variant;
 use acm_workbench::limits::swing_twist::{SwingTwistLimits, HEADER};
-use acm_workbench::limits::{JointLimits, LimitTable, Settings, BUILTIN_TABLES};
+use acm_workbench::limits::{JointLimits, LimitTable, BUILTIN_TABLES};
 use acm_workbench::model::Model;
 use acm_workbench::rotation::{angle_between_deg, angle_deg, quat_axis_angle_deg, wxyz, Quat};
 use acm_workbench::simulate::{preset, simulate, KneeAxis, KneeImu, SimConfig};
 use acm_workbench::trial::{read_trial, Trial};
 use acm_workbench::vertical::Vertical;
-use common::engine::{geodesic_error_deg, median};
+use common::engine::{geodesic_error_deg, median, run_with_table};
 use nalgebra::Vector3;
 use std::path::Path;
 
@@ -32,18 +31,6 @@ fn swing_table() -> LimitTable {
         .find(|(n, _)| *n == "swing_twist.csv")
         .expect("shipped");
     LimitTable::parse(text, name).unwrap()
-}
-
-fn correct(trial: &Trial, model: &Model, table: &LimitTable, variant: Variant) -> Correction {
-    correct_trial(
-        trial,
-        model,
-        table,
-        &Settings::default(),
-        variant,
-        &RunControl::default(),
-    )
-    .unwrap()
 }
 
 /// The shipped table file on disk is the built-in one, reads back as
@@ -362,7 +349,7 @@ fn the_knee_test_has_no_singularity_residuals() {
         for angle in ANGLES_DEG {
             let sim = simulate(&SimConfig::knee(KneeImu::Thigh, axis, angle)).unwrap();
             let err = |t: &LimitTable, v: Variant| {
-                let c = correct(&sim.trial, &model, t, v);
+                let c = run_with_table(&model, &sim.trial, t, v);
                 geodesic_error_deg(&model, "l_knee", &c.corrected, &sim.truth.segments)
             };
             let none = geodesic_error_deg(&model, "l_knee", &sim.trial, &sim.truth.segments);
@@ -412,8 +399,8 @@ fn sample_trials_agree_with_the_euler_table_away_from_the_singularity() {
             .unwrap()
             .unwrap();
         for variant in [Variant::Basic, Variant::DriftCentroid] {
-            let a = correct(&trial, &model, &euler, variant);
-            let b = correct(&trial, &model, &st, variant);
+            let a = run_with_table(&model, &trial, &euler, variant);
+            let b = run_with_table(&model, &trial, &st, variant);
             for jr in &a.joints {
                 let j = model.joint(&jr.joint).unwrap();
                 let rot = |t: &Trial| -> Vec<Quat> {
@@ -612,8 +599,8 @@ fn heading_variants_correct_a_drifting_trial_with_a_swing_twist_table() {
     let drifts = cfg.drifts.clone();
     let sim = simulate(&cfg).unwrap();
     for variant in [Variant::DriftHeading, Variant::DriftHeadingCentroid] {
-        let a = correct(&sim.trial, &model, &euler, variant);
-        let b = correct(&sim.trial, &model, &st, variant);
+        let a = run_with_table(&model, &sim.trial, &euler, variant);
+        let b = run_with_table(&model, &sim.trial, &st, variant);
         assert!(b.skipped.is_empty(), "{:?}", b.skipped);
         assert_eq!(a.joints.len(), b.joints.len());
         let (mut touching_e, mut touching_s, mut others) = (Vec::new(), Vec::new(), Vec::new());
@@ -668,36 +655,28 @@ fn wxyz_of_the_cost_samples_is_sign_invariant() {
 /// `report` names the model; `plot globe` draws the region's edge.
 #[test]
 fn the_command_line_selects_and_records_a_swing_twist_table() {
-    use std::process::Command;
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let table = root.join("joint_limits/swing_twist.csv");
     let trial = root.join("sample_trials/elbow_20.csv.gz");
+    let (table, trial_arg) = (table.to_str().unwrap(), trial.to_str().unwrap());
     let dir = tempfile::tempdir().unwrap();
-    let acmw = || {
-        let mut c = Command::new(env!("CARGO_BIN_EXE_acmw"));
-        c.current_dir(dir.path());
-        c
-    };
+    let run_ok = |args: &[&str]| common::acmw_ok(dir.path(), args);
     // `auto` (which tries the heading variants) with the table: the file is
     // written and reads back, every joint corrected, the sidecar names the
     // model and each joint's choice.
-    let auto = dir.path().join("auto.csv");
-    let out = acmw()
-        .args(["correct", "--quiet", "--variant", "auto", "--limits"])
-        .arg(&table)
-        .arg(&trial)
-        .arg("-o")
-        .arg(&auto)
-        .output()
-        .unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_ok(&[
+        "correct",
+        "--quiet",
+        "--variant",
+        "auto",
+        "--limits",
+        table,
+        trial_arg,
+        "-o",
+        "auto.csv",
+    ]);
     let model = Model::infant13();
-    let back = read_trial(&auto, &model).unwrap();
+    let back = read_trial(&dir.path().join("auto.csv"), &model).unwrap();
     let raw = read_trial(&trial, &model).unwrap();
     assert_eq!(back.len(), raw.len());
     let auto_json: serde_json::Value = serde_json::from_str(
@@ -711,70 +690,46 @@ fn the_command_line_selects_and_records_a_swing_twist_table() {
     for j in joints {
         assert!(j["auto"]["chosen"].is_string(), "{j}");
     }
-    let first = dir.path().join("d.csv");
-    let out = acmw()
-        .args(["correct", "--quiet", "--variant", "drift", "--limits"])
-        .arg(&table)
-        .arg(&trial)
-        .arg("-o")
-        .arg(&first)
-        .output()
-        .unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_ok(&[
+        "correct",
+        "--quiet",
+        "--variant",
+        "drift",
+        "--limits",
+        table,
+        trial_arg,
+        "-o",
+        "d.csv",
+    ]);
     let sidecar = dir.path().join("d.csv.acmw.json");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&sidecar).unwrap()).unwrap();
     assert_eq!(json["limits"]["model"], "swing-twist");
     // `auto` skipped no joint `drift` corrects.
     assert_eq!(auto_json["skipped"], json["skipped"]);
-    let again = dir.path().join("again.csv");
-    let out = acmw()
-        .args(["correct", "--quiet", "--from-sidecar"])
-        .arg(&sidecar)
-        .arg(&trial)
-        .arg("-o")
-        .arg(&again)
-        .output()
-        .unwrap();
+    run_ok(&[
+        "correct",
+        "--quiet",
+        "--from-sidecar",
+        sidecar.to_str().unwrap(),
+        trial_arg,
+        "-o",
+        "again.csv",
+    ]);
     assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        std::fs::read(dir.path().join("d.csv")).unwrap(),
+        std::fs::read(dir.path().join("again.csv")).unwrap()
     );
-    assert_eq!(
-        std::fs::read(&first).unwrap(),
-        std::fs::read(&again).unwrap()
+    let out = common::acmw(
+        dir.path(),
+        &["report", "--variant", "basic", "--limits", table, trial_arg],
     );
-    let out = acmw()
-        .args(["report", "--variant", "basic", "--limits"])
-        .arg(&table)
-        .arg(&trial)
-        .output()
-        .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("swing_twist.csv (swing-twist)"), "{text}");
-    let svg = dir.path().join("g.svg");
-    let out = acmw()
-        .args(["plot", "globe", "--joint", "l_elbow", "--limits"])
-        .arg(&table)
-        .arg(&trial)
-        .arg("-o")
-        .arg(&svg)
-        .output()
-        .unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = std::fs::read_to_string(&svg).unwrap();
+    run_ok(&[
+        "plot", "globe", "--joint", "l_elbow", "--limits", table, trial_arg, "-o", "g.svg",
+    ]);
+    let text = std::fs::read_to_string(dir.path().join("g.svg")).unwrap();
     assert!(text.contains("#D06000"), "the region's edge");
 }
 

@@ -9,17 +9,28 @@ use acm_workbench::model::Model;
 use acm_workbench::rotation::{angle_between_deg, Quat};
 use acm_workbench::trial::Trial;
 
-/// `variant` on `trial` with `model`, the default limit table and settings.
-pub fn run_on(model: &Model, trial: &Trial, variant: Variant) -> Correction {
+/// `variant` on `trial` with `model`, the limit table `table` and the default
+/// settings.
+pub fn run_with_table(
+    model: &Model,
+    trial: &Trial,
+    table: &LimitTable,
+    variant: Variant,
+) -> Correction {
     correct_trial(
         trial,
         model,
-        &LimitTable::default_table(),
+        table,
         &Settings::default(),
         variant,
         &RunControl::default(),
     )
     .unwrap()
+}
+
+/// `variant` on `trial` with `model`, the default limit table and settings.
+pub fn run_on(model: &Model, trial: &Trial, variant: Variant) -> Correction {
+    run_with_table(model, trial, &LimitTable::default_table(), variant)
 }
 
 /// [`run_on`] with `infant13`, the model of the simulated trials.
