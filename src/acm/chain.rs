@@ -843,18 +843,21 @@ fn solve_windows_with_axes(
     } else {
         None
     };
-    // A two-axis hinge's turn (lighter size term): held towards the turn the
-    // windows ask for together (see `pooled_turn`).
-    let held_deg = if turn_weight < lambda1 {
-        pooled_turn(
-            (measured, windows),
-            families,
-            child,
-            (limits, lambda1, turn_weight),
-        )
-    } else {
-        0.0
-    };
+    // A two-axis hinge's turn (lighter size term) is held towards the turn
+    // the windows ask for together (see `pooled_turn`); its window costs are
+    // built once for both searches. Other joints build each where it is
+    // solved (peak memory).
+    let prebuilt: Option<Vec<Option<WindowCost>>> = (turn_weight < lambda1).then(|| {
+        (windows.par_iter().zip(families))
+            .map(|(w, f)| {
+                f.as_ref()
+                    .map(|_| WindowCost::new(&measured[w.first..w.end], limits, lambda1))
+            })
+            .collect()
+    });
+    let held_deg = prebuilt.as_ref().map_or(0.0, |costs| {
+        pooled_turn(costs, families, child, (lambda1, turn_weight))
+    });
     let solutions: Vec<WindowSolution> = (windows.par_iter().zip(families).enumerate())
         .map(|(k, (w, family))| {
             let Some(family) = family else {
@@ -863,14 +866,21 @@ fn solve_windows_with_axes(
             if control.cancelled() {
                 return Err(Cancelled);
             }
-            let cost = WindowCost::new(&measured[w.first..w.end], limits, lambda1);
+            let built;
+            let cost = match &prebuilt {
+                Some(costs) => costs[k]
+                    .as_ref()
+                    .expect("built for every window with an axis"),
+                None => {
+                    built = WindowCost::new(&measured[w.first..w.end], limits, lambda1);
+                    &built
+                }
+            };
             // The size term counts the turn about the axis only (see `hinge`),
-            // from the held turn. A two-axis hinge below adds its limits on
-            // the turn about its proximal axis (see `ChildTerm`).
+            // from the held turn.
             let about_axis = |c: &Quat, phi: f64| {
-                cost.eval(c) - lambda1 * angle_deg(c)
+                turn_cost(cost, c, (k, child), lambda1)
                     + turn_weight * wrap180(phi - held_deg).abs()
-                    + child.map_or(0.0, |t| t.eval(k, c))
             };
             let s = hinge::minimise_about_axis(&about_axis, family);
             if free.is_none() {
@@ -909,32 +919,36 @@ fn solve_windows_with_axes(
 /// window, which the windows that see it give the others (docs/method.md
 /// section 18). Each window is then held towards it by the size term.
 fn pooled_turn(
-    (measured, windows): (&[Quat], &[Window]),
+    costs: &[Option<WindowCost>],
     families: &[Option<AxisFamily>],
     child: Option<&ChildTerm>,
-    (limits, lambda1, turn_weight): (&JointLimits, f64, f64),
+    (lambda1, turn_weight): (f64, f64),
 ) -> f64 {
-    let costs: Vec<(usize, WindowCost, &AxisFamily)> = (windows.iter().zip(families).enumerate())
-        .filter_map(|(k, (w, f))| {
-            let f = f.as_ref()?;
-            Some((
-                k,
-                WindowCost::new(&measured[w.first..w.end], limits, lambda1),
-                f,
-            ))
-        })
-        .collect();
-    let total = |phi: f64| -> f64 {
-        let parts: Vec<f64> = costs
-            .par_iter()
-            .map(|(k, cost, family)| {
-                let c = family.at(phi);
-                cost.eval(&c) - lambda1 * angle_deg(&c) + child.map_or(0.0, |t| t.eval(*k, &c))
-            })
+    let with_axis: Vec<(usize, &WindowCost, &AxisFamily)> =
+        (costs.iter().zip(families).enumerate())
+            .filter_map(|(k, (cost, f))| Some((k, cost.as_ref()?, f.as_ref()?)))
             .collect();
-        parts.iter().sum::<f64>() + turn_weight * costs.len() as f64 * wrap180(phi).abs()
+    let total = |phi: f64| -> f64 {
+        let parts: Vec<f64> = with_axis
+            .par_iter()
+            .map(|(k, cost, family)| turn_cost(cost, &family.at(phi), (*k, child), lambda1))
+            .collect();
+        parts.iter().sum::<f64>() + turn_weight * with_axis.len() as f64 * wrap180(phi).abs()
     };
     hinge::minimise_turn(&total).0
+}
+
+/// The cost of window `k`'s correction `c` about a hinge axis, without its
+/// size term (degrees): the window cost less `lambda1 * angle(c)`, plus the
+/// limits of a two-axis hinge below on the turn about its proximal axis (see
+/// `ChildTerm`).
+fn turn_cost(
+    cost: &WindowCost,
+    c: &Quat,
+    (k, child): (usize, Option<&ChildTerm>),
+    lambda1: f64,
+) -> f64 {
+    cost.eval(c) - lambda1 * angle_deg(c) + child.map_or(0.0, |t| t.eval(k, c))
 }
 
 fn results_has_imu(results: &HashMap<usize, JointResult>, model: &Model, imu: &str) -> bool {
