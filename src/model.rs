@@ -1190,8 +1190,14 @@ distal = "b"
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         let m = Model::infant13();
-        for j in &m.joints {
-            assert_eq!(j.angle_axes, IDENTITY_AXES);
+        // The back and the neck keep the segment axes.
+        let identity: Vec<&Joint> = m
+            .joints
+            .iter()
+            .filter(|j| j.angle_axes == IDENTITY_AXES)
+            .collect();
+        assert_eq!(identity.len(), 2);
+        for j in identity {
             for _ in 0..100 {
                 let t: [f64; 3] = std::array::from_fn(|_| rng.random_range(-170.0..170.0));
                 let p = crate::rotation::quat_from_euler_zyx_deg(t.map(|a| 0.5 * a));
@@ -1248,6 +1254,114 @@ distal = "b"
             }
         }
         assert!(checked >= 4 * 8, "{checked}");
+    }
+
+    /// `infant13` reads each anatomical movement from its prone calibration
+    /// pose (X towards the head, Y left, Z up; arms out to the sides, palms
+    /// and elbow creases on the floor, legs straight back) with the table's
+    /// sign: a 10 deg turn that takes a vector `from` of the distal segment
+    /// towards `to` reads +10 on the table axis named, 0 on the others.
+    #[test]
+    fn infant13_reads_anatomical_movements_from_the_prone_pose_with_the_table_sign() {
+        const X: [f64; 3] = [1.0, 0.0, 0.0];
+        const Y: [f64; 3] = [0.0, 1.0, 0.0];
+        const Z: [f64; 3] = [0.0, 0.0, 1.0];
+        let neg = |v: [f64; 3]| v.map(|a| -a);
+        // (joint, table axis, movement, vector of the distal segment, towards)
+        type Case = (&'static str, usize, &'static str, [f64; 3], [f64; 3]);
+        let cases: Vec<Case> = vec![
+            (
+                "back",
+                1,
+                "flexion: the upper back bends to the floor",
+                X,
+                neg(Z),
+            ),
+            ("back", 2, "left lateral bending", X, Y),
+            ("back", 0, "left rotation: the chest turns left", neg(Z), Y),
+            ("neck", 1, "flexion: the head bends to the floor", X, neg(Z)),
+            ("l_shoulder", 0, "flexion: the arm to the floor", Y, neg(Z)),
+            ("l_shoulder", 2, "abduction: the arm towards the head", Y, X),
+            (
+                "l_shoulder",
+                1,
+                "external rotation: the crease turns to the head",
+                neg(Z),
+                X,
+            ),
+            ("r_shoulder", 0, "flexion", neg(Y), neg(Z)),
+            ("r_shoulder", 2, "abduction", neg(Y), X),
+            ("r_shoulder", 1, "external rotation", neg(Z), X),
+            ("l_elbow", 0, "flexion: the forearm to the floor", Y, neg(Z)),
+            ("l_elbow", 2, "pronation: the thumb to the floor", X, neg(Z)),
+            (
+                "l_elbow",
+                1,
+                "abduction: the forearm towards the head",
+                Y,
+                X,
+            ),
+            ("r_elbow", 0, "flexion", neg(Y), neg(Z)),
+            ("r_elbow", 2, "pronation", X, neg(Z)),
+            ("r_elbow", 1, "abduction", neg(Y), X),
+            (
+                "l_hip",
+                1,
+                "flexion: the knee under the belly",
+                neg(X),
+                neg(Z),
+            ),
+            ("l_hip", 2, "abduction: the knee to the left", neg(X), Y),
+            (
+                "l_hip",
+                0,
+                "external rotation: the kneecap turns left",
+                neg(Z),
+                Y,
+            ),
+            ("r_hip", 1, "flexion", neg(X), neg(Z)),
+            (
+                "r_hip",
+                2,
+                "abduction: the knee to the right",
+                neg(X),
+                neg(Y),
+            ),
+            (
+                "r_hip",
+                0,
+                "external rotation: the kneecap turns right",
+                neg(Z),
+                neg(Y),
+            ),
+            ("l_knee", 1, "flexion: the foot rises", neg(X), Z),
+            ("l_knee", 0, "external rotation", neg(Z), Y),
+            ("r_knee", 1, "flexion", neg(X), Z),
+            ("r_knee", 0, "external rotation", neg(Z), neg(Y)),
+            (
+                "l_ankle",
+                1,
+                "plantar flexion: the toes turn back",
+                neg(Z),
+                neg(X),
+            ),
+            ("r_ankle", 1, "plantar flexion", neg(Z), neg(X)),
+        ];
+        let m = Model::infant13();
+        for (joint, axis, movement, from, to) in cases {
+            let j = m.joint(joint).unwrap();
+            let f = nalgebra::Vector3::from(from);
+            let n = f.cross(&nalgebra::Vector3::from(to)).normalize();
+            let r = crate::rotation::quat_axis_angle_deg([n.x, n.y, n.z], 10.0);
+            let a = j.table_angles(&r);
+            for (k, v) in a.iter().enumerate() {
+                let want = if k == axis { 10.0 } else { 0.0 };
+                assert!(
+                    (v - want).abs() < 1e-9,
+                    "{joint} {movement}: {a:?} (table axis {k})"
+                );
+            }
+        }
     }
 
     #[test]

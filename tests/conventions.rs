@@ -114,6 +114,71 @@ fn standing_movements(joint: &Joint) -> Vec<Movement> {
     }
 }
 
+/// `infant13`'s prone calibration pose (the source's Figure 2-3): head
+/// forward along the floor, the back up, arms out to the sides with palms and
+/// elbow creases on the floor, legs straight back. Pose calibration makes its
+/// segment frames: x towards the head, y left, z up (dorsal).
+const PRONE: PoseGeometry = PoseGeometry {
+    forward: V::new(1.0, 0.0, 0.0),
+    left: V::new(0.0, 1.0, 0.0),
+    up: V::new(0.0, 0.0, 1.0),
+};
+
+/// The movements of a joint of `infant13` from its prone pose, from the
+/// anatomical definitions (as [`standing_movements`]), with the body lying
+/// face down: ventral is down, cranial is `PRONE.forward`, the limbs point
+/// sideways (arms) and back (legs), the feet pointed back (soles up).
+fn prone_movements(joint: &Joint) -> Vec<Movement> {
+    let g = &PRONE;
+    let (cranial, dorsal) = (g.forward, g.up);
+    let (caudal, ventral) = (-cranial, -dorsal);
+    let right = joint.name.starts_with("r_");
+    let lateral = if right { -g.left } else { g.left };
+    let towards = |from: V, to: V| from.cross(&to).normalize();
+    let m = |name, table_axis, axis| Movement {
+        name,
+        table_axis,
+        axis,
+    };
+    match joint.kind.as_str() {
+        "back" | "neck" => vec![
+            m("left rotation", 0, towards(ventral, g.left)),
+            m("flexion", 1, towards(cranial, ventral)),
+            m("left lateral bending", 2, towards(cranial, g.left)),
+        ],
+        "hip" => vec![
+            m("external rotation", 0, towards(ventral, lateral)),
+            m("flexion", 1, towards(caudal, ventral)),
+            m("abduction", 2, towards(caudal, lateral)),
+        ],
+        "knee" => vec![
+            m("lateral rotation", 0, towards(ventral, lateral)),
+            m("flexion", 1, towards(caudal, dorsal)),
+            m("abduction", 2, towards(caudal, lateral)),
+        ],
+        "ankle" => vec![
+            m("lateral rotation", 0, towards(ventral, lateral)),
+            // The toes point back, the sole up: plantar flexion takes the
+            // toes further towards the sole.
+            m("plantar flexion", 1, towards(caudal, dorsal)),
+            m("eversion", 2, towards(caudal, lateral)),
+        ],
+        // The arm points laterally; its anterior side (the crease) faces
+        // the floor, the thumb points to the head.
+        "shoulder" => vec![
+            m("flexion", 0, towards(lateral, ventral)),
+            m("external rotation", 1, towards(ventral, cranial)),
+            m("abduction", 2, towards(lateral, cranial)),
+        ],
+        "elbow" => vec![
+            m("flexion", 0, towards(lateral, ventral)),
+            m("abduction", 1, towards(lateral, cranial)),
+            m("pronation", 2, towards(cranial, ventral)),
+        ],
+        other => panic!("no prone movements for joint kind {other}"),
+    }
+}
+
 /// The joint's angle over time, degrees: still for 1 s (the pose), then a
 /// swing between 0 and `peak`.
 fn swing(t: f64, peak: f64) -> f64 {
@@ -275,6 +340,87 @@ fn every_movement_of_every_standing_model_reads_positive_on_its_table_axis() {
         }
     }
     assert_eq!(checked, 3 * (7 + 11 + 15));
+}
+
+/// `infant13` from its prone pose: every movement of every joint, alone,
+/// reads as itself on its table axis, positive, the other axes 0; hip
+/// flexion to 100 deg, knee flexion to 140 and elbow flexion to 150 too.
+#[test]
+fn every_movement_of_infant13_reads_positive_from_its_prone_pose() {
+    let mut rng = ChaCha8Rng::seed_from_u64(18);
+    let model = Model::builtin("infant13").unwrap();
+    let mount = mountings(&model, &mut rng);
+    let mut checked = 0;
+    for joint in &model.joints {
+        for (k, mv) in prone_movements(joint).iter().enumerate() {
+            let large = match (joint.kind.as_str(), k) {
+                ("hip", 1) => Some(100.0),
+                ("knee", 1) => Some(140.0),
+                ("elbow", 0) => Some(150.0),
+                _ => None,
+            };
+            for peak in std::iter::once(40.0).chain(large) {
+                let angle = |t: f64| swing(t, peak);
+                let heading = rng.random_range(-180.0..180.0);
+                let trial =
+                    physical_trial(&model, &[(&joint.name, mv.axis, &angle)], &mount, heading);
+                let cal = calibrated(&trial, &model);
+                let want = |t: f64| {
+                    let mut w = [0.0; 3];
+                    w[mv.table_axis] = angle(t);
+                    w
+                };
+                assert_reads(&cal, joint, &format!("infant13 {} {peak}", mv.name), &want);
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 12 * 3 + 2 * 3);
+}
+
+/// A crawl of `infant13` from its prone pose: hips and knees flexing, the
+/// shoulders and elbows working; the convention check is silent on it, hip
+/// and knee flexion read positive, and a copy with one hip mirrored (moved
+/// into extension) is named.
+#[test]
+fn infant13_crawl_passes_the_convention_check_and_a_mirrored_hip_is_named() {
+    let table = LimitTable::default_table();
+    let mut rng = ChaCha8Rng::seed_from_u64(19);
+    let model = Model::builtin("infant13").unwrap();
+    let mount = mountings(&model, &mut rng);
+    let hip = |t: f64| swing(t, 80.0);
+    let knee = |t: f64| swing(t, 90.0);
+    let shoulder = |t: f64| swing(t, 40.0);
+    let elbow = |t: f64| swing(t, 70.0);
+    let extended = |t: f64| -swing(t, 30.0);
+    let axis = |j: &str, k: usize| prone_movements(model.joint(j).unwrap())[k].axis;
+    let crawl: Vec<Moving> = vec![
+        ("l_shoulder", axis("l_shoulder", 0), &shoulder),
+        ("r_shoulder", axis("r_shoulder", 0), &shoulder),
+        ("l_elbow", axis("l_elbow", 0), &elbow),
+        ("r_elbow", axis("r_elbow", 0), &elbow),
+        ("l_hip", axis("l_hip", 1), &hip),
+        ("r_hip", axis("r_hip", 1), &hip),
+        ("l_knee", axis("l_knee", 1), &knee),
+        ("r_knee", axis("r_knee", 1), &knee),
+    ];
+    let cal = calibrated(&physical_trial(&model, &crawl, &mount, -40.0), &model);
+    let w = check_conventions(&cal, &model, &table, true);
+    assert!(w.is_empty(), "{w:?}");
+    for j in ["l_hip", "r_hip", "l_knee", "r_knee"] {
+        let a = joint_angles(&cal, model.joint(j).unwrap()).unwrap();
+        let max = a.iter().map(|x| x[1]).fold(f64::MIN, f64::max);
+        let min = a.iter().map(|x| x[1]).fold(f64::MAX, f64::min);
+        assert!(max > 79.0 && min > -1e-6, "{j}: Y {min}..{max}");
+    }
+    let mut mirrored = crawl;
+    mirrored[4] = ("l_hip", axis("l_hip", 1), &extended);
+    let cal = calibrated(&physical_trial(&model, &mirrored, &mount, -40.0), &model);
+    let w = check_conventions(&cal, &model, &table, true);
+    assert!(
+        w.len() == 1 && w[0].starts_with("l_hip y:") && w[0].contains("mirrored"),
+        "{w:?}"
+    );
 }
 
 /// Asserts that `joint` of the calibrated `cal` reads `want(t)` (table
@@ -515,17 +661,21 @@ fn correlation(a: &[f64], b: &[f64]) -> f64 {
     cov / (va * vb).sqrt()
 }
 
-/// Every standing model declares its joints' angle axes (none is left to
-/// the default by accident). `infant13` keeps the thesis' frames (the
-/// default), in which its sample trials and Table 3-2 were made.
+/// Every built-in model declares its joints' angle axes (none is left to
+/// the default by accident), but `infant13`'s back and neck, whose table
+/// axes are its prone segment axes.
 #[test]
-fn every_standing_model_states_its_angle_axes() {
+fn every_model_states_its_angle_axes() {
     for (name, text) in BUILTIN_MODELS {
         let model = Model::builtin(name).unwrap();
         let joints = text.matches("[[joint]]").count();
         let declared = text.matches("\nangle_axes = ").count();
         assert_eq!(model.joints.len(), joints);
-        let want = if *name == "infant13" { 0 } else { joints };
+        let want = if *name == "infant13" {
+            joints - 2
+        } else {
+            joints
+        };
         assert_eq!(declared, want, "{name}");
     }
 }

@@ -69,9 +69,17 @@ fn mueller(label: &str, trial: &Trial, sim: &Simulated, idx: &[usize]) -> Figure
     };
     let ma = sim.truth.meta.misalignment("l_upper_arm").unwrap();
     let mb = sim.truth.meta.misalignment("l_forearm").unwrap();
-    // IMU = segment * M: the segment's Z is M^-1 Z in the IMU frame.
-    let ea = angle_between_axes_deg(&fit.proximal_axis.into(), &(ma.inverse() * Vector3::z()));
-    let eb = angle_between_axes_deg(&fit.distal_axis.into(), &(mb.inverse() * Vector3::x()));
+    // IMU = segment * M: a segment axis n is M^-1 n in the IMU frame.
+    let (np, nd) = Model::infant13()
+        .joint("l_elbow")
+        .unwrap()
+        .two_axis_hinge()
+        .segment_axes();
+    let ea = angle_between_axes_deg(
+        &fit.proximal_axis.into(),
+        &(ma.inverse() * Vector3::from(np)),
+    );
+    let eb = angle_between_axes_deg(&fit.distal_axis.into(), &(mb.inverse() * Vector3::from(nd)));
     let truth = angles(&sim.truth.segments.select(idx, "truth"));
     let a = angles(&c.corrected);
     let f = Figures {

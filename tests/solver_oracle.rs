@@ -64,7 +64,8 @@ fn check_trial(name: &str, trial: &Trial, model: &Model, variants: &[Variant], t
             let joint = model.joint(&jr.joint).unwrap();
             let lim = table
                 .joint_limits(&joint.name, &joint.kind, variant.centroid())
-                .unwrap();
+                .unwrap()
+                .in_table_axes(joint);
             let parent = &run.corrected.imu(&joint.proximal).unwrap().orientation;
             let child = &trial.imu(&joint.distal).unwrap().orientation;
             let measured: Vec<Quat> = parent

@@ -764,7 +764,8 @@ mod tests {
         let j = model.joint("l_knee").unwrap();
         let lim = LimitTable::default_table()
             .joint_limits(&j.name, &j.kind, false)
-            .unwrap();
+            .unwrap()
+            .in_table_axes(j);
         (trial, windows, lim)
     }
 

@@ -257,7 +257,7 @@ impl Default for ShapedOptions {
             initial_step_rad: 0.05,
             max_step_rad: 0.5,
             tol_x_rad: 1e-9,
-            tol_f_rel: 1e-10,
+            tol_f_rel: 1e-11,
             min_gain: 1e-12,
             max_restarts: 0,
             max_iterations: 200,

@@ -159,6 +159,12 @@ pub fn solve_joint(
 
 /// Rivest on the table-convention angles of `measured` (docs/method.md
 /// section 2.5): fitted, corrected, and turned back into joint rotations.
+/// Rivest's model (eq. 2.10-2.11) couples rotation and ab/adduction with the
+/// handedness of a right-handed frame, so where the table's axes are a
+/// mirror image of the segment frames (`det(P) = -1`, a left knee of a model
+/// whose left limbs mirror the right) it is fitted on `det(P)` times the
+/// table's angles (the angles in the proper frame `Q`) and the correction
+/// turned back; its fits are in that frame.
 fn solve_rivest(
     time_s: &[f64],
     measured: &[Quat],
@@ -167,6 +173,8 @@ fn solve_rivest(
     limit_box: Option<[[f64; 2]; 3]>,
 ) -> BaselineSolution {
     let axes = TableAxes::of(&angle_axes);
+    let det = axes.map_or(1.0, |a| a.det);
+    // The table's angles (read in its limit box), times det(P).
     let angles: Vec<[f64; 3]> = measured
         .iter()
         .map(|q| {
@@ -174,15 +182,19 @@ fn solve_rivest(
                 Some(a) => a.angles(q),
                 None => euler_zyx_deg(q),
             };
-            match &limit_box {
+            let table = match &limit_box {
                 Some(b) => crate::rotation::read_in_box(principal, b),
                 None => principal,
-            }
+            };
+            table.map(|v| det * v)
         })
         .collect();
-    let rotation = |t: [f64; 3]| match &axes {
-        Some(a) => a.rotation(t),
-        None => quat_from_euler_zyx_deg(t),
+    let rotation = |proper: [f64; 3]| {
+        let t = proper.map(|v| det * v);
+        match &axes {
+            Some(a) => a.rotation(t),
+            None => quat_from_euler_zyx_deg(t),
+        }
     };
     let fits: Vec<RivestFit> = windows
         .iter()
@@ -363,8 +375,10 @@ mod tests {
             model.joint("l_knee").unwrap(),
             model.joint("l_elbow").unwrap(),
         );
-        let zx = Hinge::Two {
-            proximal: Axis::Z,
+        // Prone frames: pronation about the arm's long axis y, flexion
+        // about the forearm's x.
+        let yx = Hinge::Two {
+            proximal: Axis::Y,
             distal: Axis::X,
         };
         assert_eq!(
@@ -377,7 +391,7 @@ mod tests {
         assert_eq!(method_for(Variant::Rivest, elbow), None);
         assert_eq!(
             method_for(Variant::Mueller, elbow),
-            Some(Method::Mueller { axes: zx })
+            Some(Method::Mueller { axes: yx })
         );
         assert_eq!(method_for(Variant::Mueller, knee), None);
         assert_eq!(method_for(Variant::DriftCentroid, knee), None);

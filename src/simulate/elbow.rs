@@ -5,10 +5,11 @@
 //! The elbow is the model's first joint of kind `elbow` (`l_elbow`). Its
 //! angles in the table's convention are flexion (X) and pronation/supination
 //! (Z), Y = 0: `G_R_forearm = G_R_upper_arm * joint.rotation([flex, 0, pro])`.
-//! In frames whose elbow holds its Y angle (`infant13`) that is
+//! In frames whose table axes are the segments' own that is
 //! `Rz(pro) Rx(flex)`: pronation turns about an axis fixed in the upper arm and
 //! flexion about one fixed in the forearm; other frames put the two on other
-//! segment axes ([`crate::model::Joint::two_axis_hinge`]).
+//! segment axes ([`crate::model::Joint::two_axis_hinge`]; `infant13`: upper
+//! arm y, forearm x).
 //! Angles are degrees, times seconds, rates in deg/s unless named rad/s.
 
 use super::{rng, Stream};
@@ -54,7 +55,7 @@ pub fn pronation_rate_deg_s(t_s: f64) -> f64 {
 /// Angular rate of the forearm segment of `elbow` at `t_s` in its own frame,
 /// rad/s, in closed form. The joint rotation of `[flex, 0, pro]` is
 /// `Q T Q^T` with `T = Rz(d pro) Rx(d flex)` (`Q`, `d`: the joint's table
-/// axes, docs/method.md section 2.5; `Q = I`, `d = 1` in `infant13`), so with a
+/// axes, docs/method.md section 2.5; `Q = I`, `d = 1` for identity axes), so with a
 /// static upper arm `w = Q (Rx(d flex)^T (d pro' Z) + d flex' X)`. A forearm
 /// IMU misaligned by `M` reads `M^-1 w` (the upper arm's reads zero).
 pub fn forearm_rate(elbow: &Joint, t_s: f64) -> Vector3<f64> {
@@ -96,7 +97,7 @@ fn perpendicular(axis: Axis, u: f64) -> [f64; 3] {
 }
 
 /// Each IMU turned `angle_deg` about an axis drawn uniformly from the directions
-/// perpendicular to its hinge axis (in `infant13`, upper arm: Z, forearm: X).
+/// perpendicular to its hinge axis (in `infant13`, upper arm: y, forearm: x).
 /// Such a misalignment tilts the hinge axis as the sensor sees it by the full
 /// angle and leaves no turn about the axis itself (which would be an angle
 /// offset no axis estimate can see; add one through the configuration's
@@ -126,7 +127,7 @@ mod tests {
     use crate::rotation::angle_deg;
     use nalgebra::Vector3;
 
-    /// `infant13` (prone frames, the elbow holds its segment Y angle) and a
+    /// `infant13` (prone frames, the elbow holds its segment Z angle) and a
     /// standing model (the elbow holds its segment X angle).
     fn models() -> [Model; 2] {
         [Model::infant13(), Model::builtin("full_body16").unwrap()]
