@@ -645,6 +645,20 @@ impl LimitTable {
         find(joint).or_else(|| find(kind))
     }
 
+    /// The limits of `joint` as the engine's costs apply them to its joint
+    /// rotations in segment frames: its [`LimitTable::joint_limits`] in the
+    /// joint's table axes ([`JointLimits::in_table_axes`]). Every cost built
+    /// from measured rotations takes these; `with_centroid = false` sets
+    /// lambda2 to 0.
+    pub fn cost_limits(
+        &self,
+        joint: &crate::model::Joint,
+        with_centroid: bool,
+    ) -> Option<JointLimits> {
+        self.joint_limits(&joint.name, &joint.kind, with_centroid)
+            .map(|l| l.in_table_axes(joint))
+    }
+
     /// The limits of one joint; `with_centroid = false` sets lambda2 to 0.
     pub fn joint_limits(
         &self,

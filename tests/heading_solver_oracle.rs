@@ -71,10 +71,7 @@ struct Tally {
 
 fn limits_of(table: &LimitTable, model: &Model, joint: &str, variant: Variant) -> JointLimits {
     let j = model.joint(joint).unwrap();
-    table
-        .joint_limits(&j.name, &j.kind, variant.centroid())
-        .unwrap()
-        .in_table_axes(j)
+    table.cost_limits(j, variant.centroid()).unwrap()
 }
 
 fn check_trial(name: &str, trial: &Trial, model: &Model, tally: &mut Tally) {

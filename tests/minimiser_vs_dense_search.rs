@@ -67,10 +67,7 @@ fn every_window_reaches_the_dense_search_optimum() {
         assert_eq!(run.joints.len(), 12);
         for jr in &run.joints {
             let joint = model.joint(&jr.joint).unwrap();
-            let lim = table
-                .joint_limits(&joint.name, &joint.kind, variant.centroid())
-                .unwrap()
-                .in_table_axes(joint);
+            let lim = table.cost_limits(joint, variant.centroid()).unwrap();
             let parent = &run.corrected.imu(&joint.proximal).unwrap().orientation;
             let child = &trial.imu(&joint.distal).unwrap().orientation;
             let measured: Vec<Quat> = parent
@@ -113,10 +110,7 @@ fn random_windows_reach_the_dense_multi_start_optimum() {
             let joint = &model.joints[rng.random_range(0..model.joints.len())];
             let w = &windows[rng.random_range(0..windows.len())];
             let centroid = rng.random_bool(0.5);
-            let lim = table
-                .joint_limits(&joint.name, &joint.kind, centroid)
-                .unwrap()
-                .in_table_axes(joint);
+            let lim = table.cost_limits(joint, centroid).unwrap();
             let parent = &trial.imu(&joint.proximal).unwrap().orientation;
             let child = &trial.imu(&joint.distal).unwrap().orientation;
             let measured: Vec<Quat> = (w.first..w.end)

@@ -62,10 +62,7 @@ fn check_trial(name: &str, trial: &Trial, model: &Model, variants: &[Variant], t
         };
         for jr in run.joints.iter().filter(|j| j.baseline.is_none()) {
             let joint = model.joint(&jr.joint).unwrap();
-            let lim = table
-                .joint_limits(&joint.name, &joint.kind, variant.centroid())
-                .unwrap()
-                .in_table_axes(joint);
+            let lim = table.cost_limits(joint, variant.centroid()).unwrap();
             let parent = &run.corrected.imu(&joint.proximal).unwrap().orientation;
             let child = &trial.imu(&joint.distal).unwrap().orientation;
             let measured: Vec<Quat> = parent

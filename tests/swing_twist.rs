@@ -239,12 +239,7 @@ fn test_limits() -> Vec<JointLimits> {
     let mut out = Vec::new();
     for name in ["l_knee", "r_elbow", "r_hip", "l_shoulder", "l_ankle"] {
         let j = model.joint(name).unwrap();
-        out.push(
-            table
-                .joint_limits(&j.name, &j.kind, true)
-                .unwrap()
-                .in_table_axes(j),
-        );
+        out.push(table.cost_limits(j, true).unwrap());
     }
     // A twist range that narrows towards the edge, a cone and an offset centre.
     let mut knee = out[0];
@@ -753,11 +748,10 @@ fn figures_count_by_the_table_model() {
     let mut differ = 0;
     for (f, fe) in figures.iter().zip(&euler_figures) {
         let j = model.joint(&f.joint).unwrap();
-        let lim = st.joint_limits(&j.name, &j.kind, false).unwrap();
+        let axes = st.cost_limits(j, false).unwrap();
         let p = &trial.imu(&j.proximal).unwrap().orientation;
         let d = &trial.imu(&j.distal).unwrap().orientation;
         let rotations: Vec<Quat> = p.iter().zip(d).map(|(p, d)| p.inverse() * d).collect();
-        let axes = lim.in_table_axes(j);
         let want = WindowCost::new(&rotations, &axes, 0.0).eval(&Quat::identity());
         let got = f.excursion.joint_mean_excursion_deg;
         assert!((got - want).abs() < 1e-9, "{}: {got} vs {want}", j.name);

@@ -329,9 +329,8 @@ fn plan_joints(
                 // The engine's costs read the joint rotations in the
                 // table's axes (docs/method.md section 2.5).
                 let lim = limits
-                    .joint_limits(&joint.name, &joint.kind, variant.centroid())
-                    .expect("checked by skip_reason")
-                    .in_table_axes(joint);
+                    .cost_limits(joint, variant.centroid())
+                    .expect("checked by skip_reason");
                 todo.push((k, lim));
             }
         }

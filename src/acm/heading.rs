@@ -762,10 +762,7 @@ mod tests {
         let windows = layout(&trial.time_s, 60.0, 30.0);
         let model = Model::infant13();
         let j = model.joint("l_knee").unwrap();
-        let lim = LimitTable::default_table()
-            .joint_limits(&j.name, &j.kind, false)
-            .unwrap()
-            .in_table_axes(j);
+        let lim = LimitTable::default_table().cost_limits(j, false).unwrap();
         (trial, windows, lim)
     }
 
