@@ -383,13 +383,57 @@ fn every_movement_of_infant13_reads_positive_from_its_prone_pose() {
     assert_eq!(checked, 12 * 3 + 2 * 3);
 }
 
+/// Bounds on the flexion (table Y, deg) of the hips and knees of a
+/// convention case: its peak above the first, its lowest above the second.
+type FlexionBounds = (f64, f64);
+
+/// `moving` (sensors by `mount`, the subject facing `heading_deg`) passes the
+/// convention check after pose calibration, the hips' and knees' flexion
+/// within `flexion`; the same with `mirrored` in place of its entry of that
+/// joint gives exactly one warning, naming that joint's y as mirrored.
+fn assert_silent_and_names_a_mirror(
+    model: &Model,
+    mount: &BTreeMap<String, Quat>,
+    moving: &[Moving],
+    heading_deg: f64,
+    flexion: FlexionBounds,
+    mirrored: Moving,
+) {
+    let table = LimitTable::default_table();
+    let name = &model.name;
+    let cal = calibrated(&physical_trial(model, moving, mount, heading_deg), model);
+    let w = check_conventions(&cal, model, &table, true);
+    assert!(w.is_empty(), "{name}: {w:?}");
+    for j in ["l_hip", "r_hip", "l_knee", "r_knee"] {
+        let a = joint_angles(&cal, model.joint(j).unwrap()).unwrap();
+        let max = a.iter().map(|x| x[1]).fold(f64::MIN, f64::max);
+        let min = a.iter().map(|x| x[1]).fold(f64::MAX, f64::min);
+        assert!(
+            max > flexion.0 && min > flexion.1,
+            "{name} {j}: Y {min}..{max}"
+        );
+    }
+    let mut copy = moving.to_vec();
+    let k = copy
+        .iter()
+        .position(|m| m.0 == mirrored.0)
+        .expect("a moving joint");
+    copy[k] = mirrored;
+    let cal = calibrated(&physical_trial(model, &copy, mount, heading_deg), model);
+    let w = check_conventions(&cal, model, &table, true);
+    let named = format!("{} y:", mirrored.0);
+    assert!(
+        w.len() == 1 && w[0].starts_with(&named) && w[0].contains("mirrored"),
+        "{name}: {w:?}"
+    );
+}
+
 /// A crawl of `infant13` from its prone pose: hips and knees flexing, the
 /// shoulders and elbows working; the convention check is silent on it, hip
 /// and knee flexion read positive, and a copy with one hip mirrored (moved
 /// into extension) is named.
 #[test]
 fn infant13_crawl_passes_the_convention_check_and_a_mirrored_hip_is_named() {
-    let table = LimitTable::default_table();
     let mut rng = ChaCha8Rng::seed_from_u64(19);
     let model = Model::builtin("infant13").unwrap();
     let mount = mountings(&model, &mut rng);
@@ -409,23 +453,8 @@ fn infant13_crawl_passes_the_convention_check_and_a_mirrored_hip_is_named() {
         ("l_knee", axis("l_knee", 1), &knee),
         ("r_knee", axis("r_knee", 1), &knee),
     ];
-    let cal = calibrated(&physical_trial(&model, &crawl, &mount, -40.0), &model);
-    let w = check_conventions(&cal, &model, &table, true);
-    assert!(w.is_empty(), "{w:?}");
-    for j in ["l_hip", "r_hip", "l_knee", "r_knee"] {
-        let a = joint_angles(&cal, model.joint(j).unwrap()).unwrap();
-        let max = a.iter().map(|x| x[1]).fold(f64::MIN, f64::max);
-        let min = a.iter().map(|x| x[1]).fold(f64::MAX, f64::min);
-        assert!(max > 79.0 && min > -1e-6, "{j}: Y {min}..{max}");
-    }
-    let mut mirrored = crawl;
-    mirrored[4] = ("l_hip", axis("l_hip", 1), &extended);
-    let cal = calibrated(&physical_trial(&model, &mirrored, &mount, -40.0), &model);
-    let w = check_conventions(&cal, &model, &table, true);
-    assert!(
-        w.len() == 1 && w[0].starts_with("l_hip y:") && w[0].contains("mirrored"),
-        "{w:?}"
-    );
+    let mirrored = ("l_hip", axis("l_hip", 1), &extended as &dyn Fn(f64) -> f64);
+    assert_silent_and_names_a_mirror(&model, &mount, &crawl, -40.0, (79.0, -1e-6), mirrored);
 }
 
 /// Asserts that `joint` of the calibrated `cal` reads `want(t)` (table
@@ -526,7 +555,6 @@ fn combined_movements_read_back_their_table_angles() {
 /// names the joint of a mirrored copy.
 #[test]
 fn gait_passes_the_convention_check_and_a_mirrored_hip_is_named() {
-    let table = LimitTable::default_table();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let hip = |t: f64| {
         if t < 1.0 {
@@ -554,23 +582,12 @@ fn gait_passes_the_convention_check_and_a_mirrored_hip_is_named() {
             ("l_ankle", flexion("l_ankle"), &ankle),
             ("r_ankle", flexion("r_ankle"), &ankle),
         ];
-        let cal = calibrated(&physical_trial(&model, &gait, &mount, 70.0), &model);
-        let w = check_conventions(&cal, &model, &table, true);
-        assert!(w.is_empty(), "{name}: {w:?}");
-        for j in ["l_hip", "r_hip", "l_knee", "r_knee"] {
-            let a = joint_angles(&cal, model.joint(j).unwrap()).unwrap();
-            let max = a.iter().map(|x| x[1]).fold(f64::MIN, f64::max);
-            let min = a.iter().map(|x| x[1]).fold(f64::MAX, f64::min);
-            assert!(max > 19.0 && min > -1.2, "{name} {j}: Y {min}..{max}");
-        }
-        let mut mirrored = gait;
-        mirrored[1] = ("r_hip", flexion("r_hip"), &hyperextended);
-        let cal = calibrated(&physical_trial(&model, &mirrored, &mount, 70.0), &model);
-        let w = check_conventions(&cal, &model, &table, true);
-        assert!(
-            w.len() == 1 && w[0].starts_with("r_hip y:") && w[0].contains("mirrored"),
-            "{name}: {w:?}"
+        let mirrored = (
+            "r_hip",
+            flexion("r_hip"),
+            &hyperextended as &dyn Fn(f64) -> f64,
         );
+        assert_silent_and_names_a_mirror(&model, &mount, &gait, 70.0, (19.0, -1.2), mirrored);
     }
 }
 
