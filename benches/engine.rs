@@ -104,7 +104,10 @@ fn benches(c: &mut Criterion) {
     // One joint (the hip, with the centroid term) re-corrected from its
     // measured rotations, as after a limit edit.
     let table = LimitTable::default_table();
-    let lim = table.joint_limits("l_hip", "hip", true).unwrap();
+    // The engine solves its joints in their table axes (`cost_limits`).
+    let lim = table
+        .cost_limits(Model::infant13().joint("l_hip").unwrap(), true)
+        .unwrap();
     let base = &five.imu("base").unwrap().orientation;
     let thigh = &five.imu("l_thigh").unwrap().orientation;
     let measured: Vec<Quat> = base

@@ -748,19 +748,19 @@ fn figures_count_by_the_table_model() {
     let mut differ = 0;
     for (f, fe) in figures.iter().zip(&euler_figures) {
         let j = model.joint(&f.joint).unwrap();
-        let axes = st.cost_limits(j, false).unwrap();
+        let lim = st.cost_limits(j, false).unwrap();
         let p = &trial.imu(&j.proximal).unwrap().orientation;
         let d = &trial.imu(&j.distal).unwrap().orientation;
         let rotations: Vec<Quat> = p.iter().zip(d).map(|(p, d)| p.inverse() * d).collect();
-        let want = WindowCost::new(&rotations, &axes, 0.0).eval(&Quat::identity());
+        let want = WindowCost::new(&rotations, &lim, 0.0).eval(&Quat::identity());
         let got = f.excursion.joint_mean_excursion_deg;
         assert!((got - want).abs() < 1e-9, "{}: {got} vs {want}", j.name);
         // Outside on any axis: the swing beyond its region or the twist
         // beyond its range, by the independent formula.
-        let stl = axes.swing_twist.unwrap();
+        let stl = lim.swing_twist.unwrap();
         let outside = rotations
             .iter()
-            .filter(|r| direct_excursion(&stl, &axes.to_axes(r)) > 1e-9)
+            .filter(|r| direct_excursion(&stl, &lim.to_axes(r)) > 1e-9)
             .count();
         let pct = 100.0 * outside as f64 / rotations.len() as f64;
         assert!(

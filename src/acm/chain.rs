@@ -1277,7 +1277,7 @@ mod tests {
             .zip(calf)
             .map(|(p, c)| p.inverse() * c)
             .collect();
-        let lim = table.joint_limits(&knee.name, &knee.kind, true).unwrap();
+        let lim = table.cost_limits(knee, true).unwrap();
         let windows = layout(&trial.time_s, 60.0, 30.0);
         let alone = correct_joint(&trial.time_s, &measured, &windows, &lim, 0.05);
         assert_eq!(alone.windows, run.joint("l_knee").unwrap().windows);
