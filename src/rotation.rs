@@ -55,20 +55,69 @@ pub fn other_zyx_deg([x, y, z]: [f64; 3]) -> [f64; 3] {
     [half_turn(x), y2, half_turn(z)]
 }
 
-/// `Ex + Ey + Ez`: the summed excursion (degrees) of angles beyond a box, as
-/// `acm::cost::excursion` counts it per axis (`a - hi` above, `lo - a` below).
-fn total_excursion(angles: [f64; 3], range_deg: &[[f64; 2]; 3]) -> f64 {
-    let mut sum = 0.0;
-    for (a, [lo, hi]) in angles.into_iter().zip(range_deg) {
-        sum += if a > *hi {
-            a - hi
-        } else if a < *lo {
-            lo - a
-        } else {
-            0.0
-        };
+/// Excursion (degrees) of an angle `a` read on the circle, in `(-180, 180]`,
+/// beyond the arc `[lo, hi]`, and its slope in `a`: the shorter way round to
+/// the arc. `a - hi` (slope +1) above and `lo - a` (slope -1) below, as long
+/// as that is shorter than going round the other way; past the middle of the
+/// forbidden arc, `lo + 360 - a` (-1) or `a + 360 - hi` (+1). So an angle
+/// just across +-180 from a limit near it is that little beyond it, and the
+/// excursion is continuous where the reading wraps. For a range symmetric
+/// about 0 it is `a - hi` above and `lo - a` below everywhere; `(0, 0)`
+/// inside (also inside by a wrap, for a range reaching beyond +-180).
+#[inline(always)]
+pub fn beyond_arc_slope(a: f64, lo: f64, hi: f64) -> (f64, f64) {
+    let (direct, round, slope) = if a > hi {
+        (a - hi, lo + 360.0 - a, 1.0)
+    } else if a < lo {
+        (lo - a, a + 360.0 - hi, -1.0)
+    } else {
+        return (0.0, 0.0);
+    };
+    if round <= 0.0 {
+        (0.0, 0.0)
+    } else if round < direct {
+        (round, -slope)
+    } else {
+        (direct, slope)
     }
-    sum
+}
+
+/// The excursion of [`beyond_arc_slope`] alone, degrees.
+#[inline(always)]
+pub fn beyond_arc(a: f64, lo: f64, hi: f64) -> f64 {
+    beyond_arc_slope(a, lo, hi).0
+}
+
+/// Excursion (degrees) of the middle angle `a` beyond `[lo, hi]`: `a - hi`
+/// above, `lo - a` below, 0 inside (it does not wrap).
+#[inline(always)]
+pub fn beyond_line(a: f64, lo: f64, hi: f64) -> f64 {
+    if a > hi {
+        a - hi
+    } else if a < lo {
+        lo - a
+    } else {
+        0.0
+    }
+}
+
+/// Per-axis excursion (degrees) of Z-Y-X angles `[x, y, z]` beyond a box:
+/// the first and last angle on the circle ([`beyond_arc`]), the middle one
+/// on the line ([`beyond_line`]).
+pub fn box_excursion(angles: [f64; 3], range_deg: &[[f64; 2]; 3]) -> [f64; 3] {
+    let [x, y, z] = angles;
+    let [rx, ry, rz] = range_deg;
+    [
+        beyond_arc(x, rx[0], rx[1]),
+        beyond_line(y, ry[0], ry[1]),
+        beyond_arc(z, rz[0], rz[1]),
+    ]
+}
+
+/// `Ex + Ey + Ez`: the summed excursion (degrees) of angles beyond a box
+/// ([`box_excursion`]).
+fn total_excursion(angles: [f64; 3], range_deg: &[[f64; 2]; 3]) -> f64 {
+    box_excursion(angles, range_deg).iter().sum()
 }
 
 /// Whether a box's Y range (degrees) reaches beyond +-90: only then can the
@@ -246,5 +295,59 @@ mod tests {
         let q = quat_from_wxyz([-0.5, 0.5, 0.5, 0.5]);
         assert!(canonical(&q).w > 0.0);
         assert!(angle_between_deg(&q, &canonical(&q)) < 1e-9);
+    }
+
+    #[test]
+    fn arc_excursion_is_plain_for_a_symmetric_range() {
+        for a in [-179.0, -120.0, -31.0, -30.0, 0.0, 30.0, 45.0, 179.5, 180.0] {
+            assert_eq!(
+                beyond_arc(a, -30.0, 30.0),
+                beyond_line(a, -30.0, 30.0),
+                "{a}"
+            );
+        }
+        assert_eq!(beyond_arc_slope(100.0, -30.0, 30.0), (70.0, 1.0));
+        assert_eq!(beyond_arc_slope(-100.0, -30.0, 30.0), (70.0, -1.0));
+        assert_eq!(beyond_arc_slope(10.0, -30.0, 30.0), (0.0, 0.0));
+    }
+
+    #[test]
+    fn arc_excursion_goes_the_shorter_way_round() {
+        // Elbow flexion [0, 160]: -150 deg is 150 below 0 but only 50 past 160.
+        assert_eq!(beyond_arc_slope(-150.0, 0.0, 160.0), (50.0, 1.0));
+        assert_eq!(beyond_arc_slope(170.0, 0.0, 160.0), (10.0, 1.0));
+        assert_eq!(beyond_arc_slope(-10.0, 0.0, 160.0), (10.0, -1.0));
+        // The middle of the forbidden arc (-100) is 100 from both limits.
+        assert_eq!(beyond_arc(-100.0, 0.0, 160.0), 100.0);
+        // Continuous across the reading's wrap at +-180: both sides 20 past 160.
+        let below = beyond_arc(180.0, 0.0, 160.0);
+        let above = beyond_arc(-180.0 + 1e-9, 0.0, 160.0);
+        assert_eq!(below, 20.0);
+        assert!((above - 20.0).abs() < 1e-8, "{above}");
+        // And everywhere: no jump larger than the step between neighbours.
+        let mut last = beyond_arc(-180.0, 0.0, 160.0);
+        for k in 1..=3600 {
+            let a = -180.0 + k as f64 * 0.1;
+            let e = beyond_arc(a, 0.0, 160.0);
+            assert!((e - last).abs() <= 0.1 + 1e-9, "{a}: {last} -> {e}");
+            last = e;
+        }
+    }
+
+    #[test]
+    fn arc_excursion_knows_a_range_that_wraps() {
+        // [-10, 200] covers -180..-160 as well: inside by the wrap.
+        assert_eq!(beyond_arc_slope(-170.0, -10.0, 200.0), (0.0, 0.0));
+        assert_eq!(beyond_arc_slope(-100.0, -10.0, 200.0), (60.0, 1.0));
+        assert_eq!(beyond_arc_slope(-20.0, -10.0, 200.0), (10.0, -1.0));
+    }
+
+    #[test]
+    fn box_excursion_reads_only_the_middle_angle_on_the_line() {
+        let range = [[0.0, 160.0], [0.0, 160.0], [0.0, 160.0]];
+        assert_eq!(
+            box_excursion([-150.0, -150.0, -150.0], &range),
+            [50.0, 150.0, 50.0]
+        );
     }
 }

@@ -9,7 +9,11 @@
 //! knees' RMS rotation error against the truth was 55.1 / 55.0 deg (`basic`,
 //! left / right) and 73.5 / 72.1 deg (`drift-centroid`); the hips' 9.5 / 10.5
 //! and 64.1 / 63.5 deg. Now it is 0.44 / 0.42 deg for both, the measured
-//! trial's own (0.43 / 0.42: two IMUs' noise).
+//! trial's own (0.43 / 0.42: two IMUs' noise). The hips' `drift-centroid`
+//! cost still has a lower basin 64 deg away (the standing centroid pulling a
+//! crawling hip); the gradient solver's basin screen took it, and the knees'
+//! error rose to 67 deg, until its reach was bounded (30 deg from the
+//! descent's end, `ScreenOptions::reach_deg`).
 
 use acm_workbench::acm::{RunControl, Variant};
 use acm_workbench::correct::correct_trial;

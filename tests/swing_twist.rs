@@ -206,12 +206,12 @@ fn direct_excursion(l: &SwingTwistLimits, q: &Quat) -> f64 {
     let f = u.min(1.0);
     let lo = l.twist_deg[0] + (l.edge_twist_deg[0] - l.twist_deg[0]) * f;
     let hi = l.twist_deg[1] + (l.edge_twist_deg[1] - l.twist_deg[1]) * f;
-    let twist_e = if tw > hi {
-        tw - hi
-    } else if tw < lo {
-        lo - tw
-    } else {
+    // The twist is an angle on the circle: 0 on the arc from lo to hi, else
+    // the shorter way round to either end.
+    let twist_e = if (tw - lo).rem_euclid(360.0) <= hi - lo {
         0.0
+    } else {
+        (tw - hi).rem_euclid(360.0).min((lo - tw).rem_euclid(360.0))
     };
     swing_e + twist_e
 }

@@ -20,7 +20,8 @@ use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
 use super::hinge::{self, AxisFamily, HingeFits};
 use super::lookahead::{ChildJoint, Lookahead};
 use super::minimise::{
-    minimise, minimise_shaped, MinimiseOptions, ShapedCost, ShapedOptions, Solution, Solver,
+    minimise, minimise_shaped, screen_basins, MinimiseOptions, ScreenOptions, ShapedCost,
+    ShapedOptions, Solution, Solver,
 };
 use super::window::{correction_series, layout, whole_trial, Window};
 use super::{
@@ -1104,7 +1105,13 @@ pub fn correct_joint_with(
     .expect("no cancel flag")
 }
 
-/// Minimises one window's cost from `starts` with `solver`.
+/// Samples of the coarse copy of a window's cost that [`screen_basins`]
+/// scores its probes on (about; every `len / SCREEN_SAMPLES`-th sample).
+const SCREEN_SAMPLES: usize = 200;
+
+/// Minimises one window's cost from `starts` with `solver`; the gradient
+/// solver then screens the neighbourhood of its end for a lower basin
+/// ([`screen_basins`]).
 pub fn solve_window(cost: &WindowCost, starts: &[Quat], solver: Solver) -> Solution {
     match solver {
         Solver::NelderMead => minimise(&|c| cost.eval(c), starts, &MinimiseOptions::default()),
@@ -1114,7 +1121,16 @@ pub fn solve_window(cost: &WindowCost, starts: &[Quat], solver: Solver) -> Solut
                 data: &data,
                 cone: cost.lambda1(),
             };
-            minimise_shaped(&shaped, starts, &ShapedOptions::default())
+            let opts = ShapedOptions::default();
+            let found = minimise_shaped(&shaped, starts, &opts);
+            let stride = cost.len() / SCREEN_SAMPLES;
+            let screen = (&opts, &ScreenOptions::default());
+            if stride > 1 {
+                let coarse = cost.coarse(stride);
+                screen_basins(&shaped, &|c| coarse.eval(c), found, screen)
+            } else {
+                screen_basins(&shaped, &|c| cost.eval(c), found, screen)
+            }
         }
     }
 }

@@ -15,17 +15,10 @@ use crate::rotation::{angle_deg, euler_zyx_deg, quat_from_euler_zyx_deg, Quat};
 use nalgebra::Vector3;
 
 /// Excursion of one angle `a` beyond `[lo, hi]` (degrees): `a - hi` above,
-/// `lo - a` below, 0 inside.
-#[inline(always)]
-pub fn beyond(a: f64, lo: f64, hi: f64) -> f64 {
-    if a > hi {
-        a - hi
-    } else if a < lo {
-        lo - a
-    } else {
-        0.0
-    }
-}
+/// `lo - a` below, 0 inside. The Z-Y-X middle angle's; the first and last
+/// are read on the circle ([`beyond_arc`]).
+pub use crate::rotation::beyond_line as beyond;
+use crate::rotation::{beyond_arc, beyond_arc_slope};
 
 /// [`beyond`] and its slope: +1 above the range, -1 below, 0 inside.
 #[inline(always)]
@@ -42,9 +35,11 @@ fn beyond_slope(a: f64, lo: f64, hi: f64) -> (f64, f64) {
 /// Degrees per radian.
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
-/// Per-sample excursion of angles `[x, y, z]` (degrees) beyond `[lo, hi]` per axis.
+/// Per-sample excursion of Z-Y-X angles `[x, y, z]` (degrees) beyond
+/// `[lo, hi]` per axis (x and z on the circle, see
+/// [`crate::rotation::box_excursion`]).
 pub fn excursion(angles_deg: [f64; 3], range_deg: &[[f64; 2]; 3]) -> [f64; 3] {
-    std::array::from_fn(|axis| beyond(angles_deg[axis], range_deg[axis][0], range_deg[axis][1]))
+    crate::rotation::box_excursion(angles_deg, range_deg)
 }
 
 /// Sign-invariant Euclidean distance between unit quaternions (eq. 3.17-3.21):
@@ -117,7 +112,7 @@ impl ArcRange {
         if inside && (s != 0.0 || c != 0.0) {
             return 0.0;
         }
-        beyond(s.atan2(c).to_degrees(), self.lo, self.hi)
+        beyond_arc(s.atan2(c).to_degrees(), self.lo, self.hi)
     }
 
     /// As [`ArcRange::excursion`], with the excursion's slope in the angle
@@ -127,7 +122,7 @@ impl ArcRange {
         if self.inside(s, c) {
             return (0.0, 0.0);
         }
-        beyond_slope(s.atan2(c).to_degrees(), self.lo, self.hi)
+        beyond_arc_slope(s.atan2(c).to_degrees(), self.lo, self.hi)
     }
 
     /// As [`ArcRange::excursion_slope`] for the other Z-Y-X triplet's angle,
@@ -141,7 +136,7 @@ impl ArcRange {
         if a <= -180.0 {
             a = 180.0;
         }
-        beyond_slope(a, self.lo, self.hi)
+        beyond_arc_slope(a, self.lo, self.hi)
     }
 
     /// [`ArcRange::inside`] without branches on the sample (bitwise tests),
@@ -627,6 +622,23 @@ impl WindowCost {
     /// As [`WindowCost::new`], taking every `stride`-th sample (a coarse copy).
     pub fn strided(measured: &[Quat], stride: usize, limits: &JointLimits, lambda1: f64) -> Self {
         WindowCost::from_iter(measured.iter().step_by(stride.max(1)), limits, lambda1)
+    }
+
+    /// A coarse copy of this cost: every `stride`-th of its samples, the
+    /// same limits and `lambda1`.
+    pub fn coarse(&self, stride: usize) -> Self {
+        let stride = stride.max(1);
+        let take = |v: &Vec<f64>| v.iter().step_by(stride).copied().collect::<Vec<f64>>();
+        WindowCost {
+            samples: Samples {
+                r: std::array::from_fn(|k| take(&self.samples.r[k])),
+                q: std::array::from_fn(|k| take(&self.samples.q[k])),
+            },
+            terms: self.terms.clone(),
+            lambda1: self.lambda1,
+            axes: self.axes,
+            swing: self.swing,
+        }
     }
 
     fn from_iter<'a>(

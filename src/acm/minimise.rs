@@ -18,7 +18,7 @@
 //!   is tested against (the heading variants' C steps use either, as
 //!   [`super::heading::HeadingOptions::solver`] says).
 
-use crate::rotation::{angle_deg, quat_from_rotvec, Quat};
+use crate::rotation::{angle_between_deg, angle_deg, quat_from_rotvec, Quat};
 use nalgebra::{Matrix3, Vector3};
 
 pub use crate::limits::Solver;
@@ -302,6 +302,110 @@ pub fn minimise_shaped(cost: &ShapedCost, starts: &[Quat], opts: &ShapedOptions)
     }
 }
 
+/// Tuning of [`screen_basins`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScreenOptions {
+    /// Distances of the probes from the descent's end, degrees.
+    pub radii_deg: [f64; 4],
+    /// Most probes descended from per round.
+    pub keep: usize,
+    /// Most rounds (each from the best point so far).
+    pub rounds: usize,
+    /// Farthest a lower basin's end may lie from the descent's end, degrees.
+    pub reach_deg: f64,
+}
+
+impl Default for ScreenOptions {
+    fn default() -> Self {
+        ScreenOptions {
+            radii_deg: [1.5, 5.0, 12.0, 24.0],
+            keep: 2,
+            rounds: 3,
+            reach_deg: 30.0,
+        }
+    }
+}
+
+/// The 26 directions from the centre of a cube to its faces, edges and
+/// corners, unit length.
+fn cube_directions() -> [Vector3<f64>; 26] {
+    let mut out = [Vector3::zeros(); 26];
+    let mut n = 0;
+    for i in -1..=1 {
+        for j in -1..=1 {
+            for k in -1..=1 {
+                if (i, j, k) != (0, 0, 0) {
+                    out[n] = Vector3::new(i as f64, j as f64, k as f64).normalize();
+                    n += 1;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Looks for a lower basin around the end of a descent, `found`.
+///
+/// A window's cost can have separate minima (wide limits, a parent not yet
+/// corrected), and a descent from identity stops in the first it reaches.
+/// Probes `C * exp(r d)` at the radii of `screen` (degrees) along the 26
+/// directions of a cube are scored on `coarse`, a cheap copy of the cost
+/// (every few samples of the window); the lowest `keep` that `coarse` puts
+/// below `C` and the full cost confirms below `found` are descended from with
+/// [`minimise_shaped`]'s descent. A lower end within `reach_deg` of `found`
+/// moves `C` there and the screen runs again, up to `rounds` times. The
+/// result is never above `found`.
+///
+/// The screen repairs a descent that stopped short (against a kink, or in a
+/// shallow dent beside the basin it was heading for); it does not trade the
+/// descent's basin for a far one. A basin much farther away is another
+/// reading of the joint rather than the sensor's misalignment: the centroid
+/// prior of a standing hip pulls a crawling hip's correction 64 deg away, to
+/// a cost half the near basin's.
+///
+/// `evaluations` counts evaluations of the full cost only (the probes cost
+/// about `104 * coarse samples` per round).
+pub fn screen_basins(
+    cost: &ShapedCost,
+    coarse: &dyn Fn(&Quat) -> f64,
+    found: Solution,
+    (opts, screen): (&ShapedOptions, &ScreenOptions),
+) -> Solution {
+    let directions = cube_directions();
+    let mut best = found;
+    for _ in 0..screen.rounds {
+        let here = coarse(&best.c);
+        let mut probes: Vec<(f64, Quat)> = screen
+            .radii_deg
+            .iter()
+            .flat_map(|r| directions.iter().map(move |d| d * r.to_radians()))
+            .map(|v| best.c * quat_from_rotvec(&v))
+            .map(|p| (coarse(&p), p))
+            .filter(|(s, _)| *s < here)
+            .collect();
+        probes.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut improved = false;
+        for (_, p) in probes.iter().take(screen.keep) {
+            best.evaluations += 1;
+            if cost.at(p).0 >= best.cost {
+                continue;
+            }
+            let (c, f, n) = quasi_newton(cost, p, opts);
+            best.evaluations += n;
+            let near = angle_between_deg(&c, &found.c) <= screen.reach_deg;
+            if near && f < best.cost - opts.min_gain {
+                best.c = c;
+                best.cost = f;
+                improved = true;
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    best
+}
+
 /// One BFGS descent from `base` over `v` in `base * exp(v)`. Returns the best
 /// rotation, its cost and the evaluations spent.
 fn quasi_newton(cost: &ShapedCost, base: &Quat, opts: &ShapedOptions) -> (Quat, f64, usize) {
@@ -419,7 +523,7 @@ fn wolfe(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rotation::{angle_between_deg, angle_deg, quat_axis_angle_deg};
+    use crate::rotation::quat_axis_angle_deg;
 
     #[test]
     fn finds_a_smooth_minimum() {
@@ -452,5 +556,102 @@ mod tests {
             &MinimiseOptions::default(),
         );
         assert!(s.cost < 1e-3, "{s:?}");
+    }
+
+    /// [`basins`] with B 20 deg about Y, 22 deg from A.
+    fn two_basins(c: &Quat) -> (f64, Vector3<f64>) {
+        basins(c, 20.0)
+    }
+
+    /// `min(0.1 + dA^2, dB^2)` in radians to A, 10 deg about X, and B,
+    /// `b_deg` about Y, with a central-difference gradient: a shallow basin at
+    /// A, the lower one at B.
+    fn basins(c: &Quat, b_deg: f64) -> (f64, Vector3<f64>) {
+        let a = quat_axis_angle_deg([1.0, 0.0, 0.0], 10.0);
+        let b = quat_axis_angle_deg([0.0, 1.0, 0.0], b_deg);
+        let f = |c: &Quat| {
+            let da = angle_between_deg(c, &a).to_radians();
+            let db = angle_between_deg(c, &b).to_radians();
+            (0.1 + da * da).min(db * db)
+        };
+        let h = 1e-6;
+        let g = Vector3::from_fn(|k, _| {
+            let step = Vector3::from_fn(|j, _| if j == k { h } else { 0.0 });
+            (f(&(c * quat_from_rotvec(&step))) - f(&(c * quat_from_rotvec(&-step)))) / (2.0 * h)
+        });
+        (f(c), g)
+    }
+
+    #[test]
+    fn the_screen_leaves_a_shallow_basin_for_a_lower_one() {
+        let shaped = ShapedCost {
+            data: &two_basins,
+            cone: 0.0,
+        };
+        let a = quat_axis_angle_deg([1.0, 0.0, 0.0], 10.0);
+        let found = Solution {
+            c: a,
+            cost: 0.1,
+            evaluations: 0,
+        };
+        let coarse = |c: &Quat| two_basins(c).0;
+        let opts = (&ShapedOptions::default(), &ScreenOptions::default());
+        let s = screen_basins(&shaped, &coarse, found, opts);
+        let b = quat_axis_angle_deg([0.0, 1.0, 0.0], 20.0);
+        assert!(s.cost < 1e-8, "{s:?}");
+        assert!(angle_between_deg(&s.c, &b) < 1e-2, "{s:?}");
+        assert!(s.evaluations > 0);
+    }
+
+    #[test]
+    fn the_screen_leaves_a_far_basin_alone() {
+        // B 35 deg about Y is 36 deg from A: beyond the screen's reach, though
+        // a probe 24 deg towards it is below A.
+        let far = |c: &Quat| basins(c, 35.0);
+        let shaped = ShapedCost {
+            data: &far,
+            cone: 0.0,
+        };
+        let a = quat_axis_angle_deg([1.0, 0.0, 0.0], 10.0);
+        let found = Solution {
+            c: a,
+            cost: 0.1,
+            evaluations: 0,
+        };
+        let coarse = |c: &Quat| far(c).0;
+        let opts = (&ShapedOptions::default(), &ScreenOptions::default());
+        let s = screen_basins(&shaped, &coarse, found, opts);
+        assert_eq!((s.c, s.cost), (a, 0.1), "{s:?}");
+        // Within reach it is found.
+        let reach = ScreenOptions {
+            reach_deg: 60.0,
+            ..ScreenOptions::default()
+        };
+        let s = screen_basins(&shaped, &coarse, found, (opts.0, &reach));
+        assert!(s.cost < 1e-8, "{s:?}");
+    }
+
+    #[test]
+    fn the_screen_never_returns_worse_than_it_was_given() {
+        // At B's minimum nothing around is lower: the answer is kept as is.
+        let shaped = ShapedCost {
+            data: &two_basins,
+            cone: 0.0,
+        };
+        let b = quat_axis_angle_deg([0.0, 1.0, 0.0], 20.0);
+        let found = Solution {
+            c: b,
+            cost: 0.0,
+            evaluations: 7,
+        };
+        let coarse = |c: &Quat| two_basins(c).0;
+        let opts = (&ShapedOptions::default(), &ScreenOptions::default());
+        let s = screen_basins(&shaped, &coarse, found, opts);
+        assert_eq!(s, found);
+        // A coarse copy that misjudges (it puts every probe below) costs full
+        // evaluations but cannot make the answer worse.
+        let liar = |c: &Quat| -angle_deg(c);
+        let s = screen_basins(&shaped, &liar, found, opts);
+        assert_eq!((s.c, s.cost), (b, 0.0));
     }
 }

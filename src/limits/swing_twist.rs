@@ -215,14 +215,7 @@ impl SwingTwistLimits {
         let [l1, h1] = self.edge_twist_deg;
         let lo = S::from(l0) + S::from(l1 - l0) * f;
         let hi = S::from(h0) + S::from(h1 - h0) * f;
-        let twist_e = if tw.val() > hi.val() {
-            tw - hi
-        } else if tw.val() < lo.val() {
-            lo - tw
-        } else {
-            S::from(0.0)
-        };
-        (swing_e, twist_e, [s1.val(), s2.val()])
+        (swing_e, beyond_arc(tw, lo, hi), [s1.val(), s2.val()])
     }
 
     /// The distance of a swing offset `p` from the centre (degrees) beyond
@@ -363,6 +356,28 @@ fn coordinates<S: Scalar>(t: usize, q: [S; 4]) -> [S; 3] {
 /// sample trials the nearer of the two to the table's Z-Y-X angles).
 pub fn twist_in_proximal(t: usize) -> bool {
     t == 2
+}
+
+/// Excursion (degrees) of a twist `a`, read in `(-180, 180]`, beyond the
+/// arc `[lo, hi]`, the shorter way round (as
+/// [`crate::rotation::beyond_arc_slope`] reads the Euler box's X and Z): an
+/// asymmetric range such as the elbow's `[0, 160]` has no jump where the
+/// reading wraps at +-180.
+fn beyond_arc<S: Scalar>(a: S, lo: S, hi: S) -> S {
+    let (direct, round) = if a.val() > hi.val() {
+        (a - hi, lo + S::from(360.0) - a)
+    } else if a.val() < lo.val() {
+        (lo - a, a + S::from(360.0) - hi)
+    } else {
+        return S::from(0.0);
+    };
+    if round.val() <= 0.0 {
+        S::from(0.0)
+    } else if round.val() < direct.val() {
+        round
+    } else {
+        direct
+    }
 }
 
 /// [`coordinates`] for `R = swing * twist`.
@@ -885,6 +900,39 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn an_asymmetric_twist_range_has_no_wall_where_the_twist_wraps() {
+        // Elbow flexion as the twist, [0, 160]: past 180 the reading wraps to
+        // -180, and the excursion goes on from 20 deg past 160 rather than
+        // jumping to 180 below 0.
+        let elbow = SwingTwistLimits {
+            twist_axis: 0,
+            centre_deg: [0.0, 0.0],
+            half_deg: [5.0, 30.0],
+            corner_deg: Some(0.0),
+            twist_deg: [0.0, 160.0],
+            edge_twist_deg: [0.0, 160.0],
+        };
+        let e = |deg: f64| elbow.excursion(wxyz(&quat_axis_angle_deg([1.0, 0.0, 0.0], deg)));
+        assert!((e(170.0) - 10.0).abs() < 1e-9);
+        assert!((e(179.0) - 19.0).abs() < 1e-9);
+        assert!((e(181.0) - 21.0).abs() < 1e-9, "{}", e(181.0));
+        assert!((e(-10.0) - 10.0).abs() < 1e-9);
+        // The middle of the forbidden arc, -100 deg, is 100 from both ends.
+        assert!((e(-100.0) - 100.0).abs() < 1e-9);
+        let mut last = e(0.0);
+        for k in 1..=720 {
+            let now = e(k as f64 * 0.5);
+            assert!((now - last).abs() <= 0.5 + 1e-6, "{k}: {last} -> {now}");
+            last = now;
+        }
+        // The gradient follows the shorter way: at 200 deg (-160 read) the
+        // excursion grows with the flexion.
+        let (v, g) = elbow.excursion_grad(wxyz(&quat_axis_angle_deg([1.0, 0.0, 0.0], 200.0)));
+        assert!((v - 40.0).abs() < 1e-9);
+        assert!((g[0] - DEG).abs() < 1e-6, "{g:?}");
     }
 
     #[test]
