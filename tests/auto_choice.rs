@@ -286,8 +286,8 @@ fn assert_targets(f: &Figures, hindsight: bool) {
 /// both motions). Six trials (seeds 101-106, the set this test ran on before)
 /// are too few for a median: after `infant13` declared its prone axes auto
 /// came 0.19 deg above `drift-heading-centroid` there while it is 0.30 below
-/// it on these 24 (measured 3.66 against 3.96, mean worst 8.42 against
-/// `drift-centroid`'s 8.45).
+/// it on these 24 (measured 3.66 against 3.96, mean worst 7.40 against
+/// `drift-centroid`'s 8.19).
 #[test]
 fn auto_beats_every_single_variant_on_held_out_trials() {
     let seeds: Vec<u64> = (201..=224).collect();
