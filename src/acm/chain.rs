@@ -1107,12 +1107,22 @@ pub fn correct_joint_with(
 
 /// Samples of the coarse copy of a window's cost that [`screen_basins`]
 /// scores its probes on (about; every `len / SCREEN_SAMPLES`-th sample).
-const SCREEN_SAMPLES: usize = 200;
+const SCREEN_SAMPLES: usize = 100;
 
 /// Minimises one window's cost from `starts` with `solver`; the gradient
 /// solver then screens the neighbourhood of its end for a lower basin
 /// ([`screen_basins`]).
 pub fn solve_window(cost: &WindowCost, starts: &[Quat], solver: Solver) -> Solution {
+    solve_window_screened(cost, starts, solver, true)
+}
+
+/// [`solve_window`], the gradient solver's screen only when `screen`.
+fn solve_window_screened(
+    cost: &WindowCost,
+    starts: &[Quat],
+    solver: Solver,
+    screen: bool,
+) -> Solution {
     match solver {
         Solver::NelderMead => minimise(&|c| cost.eval(c), starts, &MinimiseOptions::default()),
         Solver::Gradient => {
@@ -1123,6 +1133,9 @@ pub fn solve_window(cost: &WindowCost, starts: &[Quat], solver: Solver) -> Solut
             };
             let opts = ShapedOptions::default();
             let found = minimise_shaped(&shaped, starts, &opts);
+            if !screen {
+                return found;
+            }
             let stride = cost.len() / SCREEN_SAMPLES;
             let screen = (&opts, &ScreenOptions::default());
             if stride > 1 {
@@ -1194,7 +1207,9 @@ fn solve_windows(
             if neighbours.is_empty() {
                 return (first[k], uncorrected);
             }
-            let s = solve_window(&cost, &neighbours, solver);
+            // The first pass's solution was screened; a descent from a
+            // neighbour's replaces it only where it ends lower.
+            let s = solve_window_screened(&cost, &neighbours, solver, false);
             let best = if s.cost < first[k].cost {
                 Solution {
                     evaluations: s.evaluations + first[k].evaluations,

@@ -306,7 +306,7 @@ pub fn minimise_shaped(cost: &ShapedCost, starts: &[Quat], opts: &ShapedOptions)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScreenOptions {
     /// Distances of the probes from the descent's end, degrees.
-    pub radii_deg: [f64; 4],
+    pub radii_deg: [f64; 3],
     /// Most probes descended from per round.
     pub keep: usize,
     /// Most rounds (each from the best point so far).
@@ -318,7 +318,7 @@ pub struct ScreenOptions {
 impl Default for ScreenOptions {
     fn default() -> Self {
         ScreenOptions {
-            radii_deg: [1.5, 5.0, 12.0, 24.0],
+            radii_deg: [5.0, 12.0, 24.0],
             keep: 2,
             rounds: 3,
             reach_deg: 30.0,
@@ -364,7 +364,7 @@ fn cube_directions() -> [Vector3<f64>; 26] {
 /// a cost half the near basin's.
 ///
 /// `evaluations` counts evaluations of the full cost only (the probes cost
-/// about `104 * coarse samples` per round).
+/// about `78 * coarse samples` per round).
 pub fn screen_basins(
     cost: &ShapedCost,
     coarse: &dyn Fn(&Quat) -> f64,
