@@ -582,21 +582,27 @@ mod tests {
         (f(c), g)
     }
 
-    #[test]
-    fn the_screen_leaves_a_shallow_basin_for_a_lower_one() {
-        let shaped = ShapedCost {
-            data: &two_basins,
-            cone: 0.0,
-        };
-        let a = quat_axis_angle_deg([1.0, 0.0, 0.0], 10.0);
+    /// [`screen_basins`] with `screen` from `c` at `cost` on `data` (no cone),
+    /// scoring the probes on `data`'s own values.
+    fn screen_at(
+        data: &dyn Fn(&Quat) -> (f64, Vector3<f64>),
+        (c, cost): (Quat, f64),
+        screen: &ScreenOptions,
+    ) -> Solution {
+        let shaped = ShapedCost { data, cone: 0.0 };
         let found = Solution {
-            c: a,
-            cost: 0.1,
+            c,
+            cost,
             evaluations: 0,
         };
-        let coarse = |c: &Quat| two_basins(c).0;
-        let opts = (&ShapedOptions::default(), &ScreenOptions::default());
-        let s = screen_basins(&shaped, &coarse, found, opts);
+        let opts = ShapedOptions::default();
+        screen_basins(&shaped, &|c| data(c).0, found, (&opts, screen))
+    }
+
+    #[test]
+    fn the_screen_leaves_a_shallow_basin_for_a_lower_one() {
+        let a = quat_axis_angle_deg([1.0, 0.0, 0.0], 10.0);
+        let s = screen_at(&two_basins, (a, 0.1), &ScreenOptions::default());
         let b = quat_axis_angle_deg([0.0, 1.0, 0.0], 20.0);
         assert!(s.cost < 1e-8, "{s:?}");
         assert!(angle_between_deg(&s.c, &b) < 1e-2, "{s:?}");
@@ -608,50 +614,39 @@ mod tests {
         // B 35 deg about Y is 36 deg from A: beyond the screen's reach, though
         // a probe 24 deg towards it is below A.
         let far = |c: &Quat| basins(c, 35.0);
-        let shaped = ShapedCost {
-            data: &far,
-            cone: 0.0,
-        };
         let a = quat_axis_angle_deg([1.0, 0.0, 0.0], 10.0);
-        let found = Solution {
-            c: a,
-            cost: 0.1,
-            evaluations: 0,
-        };
-        let coarse = |c: &Quat| far(c).0;
-        let opts = (&ShapedOptions::default(), &ScreenOptions::default());
-        let s = screen_basins(&shaped, &coarse, found, opts);
+        let s = screen_at(&far, (a, 0.1), &ScreenOptions::default());
         assert_eq!((s.c, s.cost), (a, 0.1), "{s:?}");
+        assert!(s.evaluations > 0, "it descended from a probe");
         // Within reach it is found.
         let reach = ScreenOptions {
             reach_deg: 60.0,
             ..ScreenOptions::default()
         };
-        let s = screen_basins(&shaped, &coarse, found, (opts.0, &reach));
-        assert!(s.cost < 1e-8, "{s:?}");
+        assert!(screen_at(&far, (a, 0.1), &reach).cost < 1e-8);
     }
 
     #[test]
     fn the_screen_never_returns_worse_than_it_was_given() {
         // At B's minimum nothing around is lower: the answer is kept as is.
+        let b = quat_axis_angle_deg([0.0, 1.0, 0.0], 20.0);
+        let s = screen_at(&two_basins, (b, 0.0), &ScreenOptions::default());
+        assert_eq!((s.c, s.cost, s.evaluations), (b, 0.0, 0));
+        // A coarse copy that misjudges (it puts every probe below) costs full
+        // evaluations but cannot make the answer worse.
         let shaped = ShapedCost {
             data: &two_basins,
             cone: 0.0,
         };
-        let b = quat_axis_angle_deg([0.0, 1.0, 0.0], 20.0);
         let found = Solution {
             c: b,
             cost: 0.0,
-            evaluations: 7,
+            evaluations: 0,
         };
-        let coarse = |c: &Quat| two_basins(c).0;
-        let opts = (&ShapedOptions::default(), &ScreenOptions::default());
-        let s = screen_basins(&shaped, &coarse, found, opts);
-        assert_eq!(s, found);
-        // A coarse copy that misjudges (it puts every probe below) costs full
-        // evaluations but cannot make the answer worse.
         let liar = |c: &Quat| -angle_deg(c);
+        let opts = (&ShapedOptions::default(), &ScreenOptions::default());
         let s = screen_basins(&shaped, &liar, found, opts);
         assert_eq!((s.c, s.cost), (b, 0.0));
+        assert!(s.evaluations > 0);
     }
 }
