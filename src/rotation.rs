@@ -55,49 +55,55 @@ pub fn other_zyx_deg([x, y, z]: [f64; 3]) -> [f64; 3] {
     [half_turn(x), y2, half_turn(z)]
 }
 
-/// Excursion (degrees) of an angle `a` read on the circle, in `(-180, 180]`,
-/// beyond the arc `[lo, hi]`, and its slope in `a`: the shorter way round to
-/// the arc. `a - hi` (slope +1) above and `lo - a` (slope -1) below, as long
-/// as that is shorter than going round the other way; past the middle of the
-/// forbidden arc, `lo + 360 - a` (-1) or `a + 360 - hi` (+1). So an angle
-/// just across +-180 from a limit near it is that little beyond it, and the
-/// excursion is continuous where the reading wraps. For a range symmetric
-/// about 0 it is `a - hi` above and `lo - a` below everywhere; `(0, 0)`
-/// inside (also inside by a wrap, for a range reaching beyond +-180).
+/// The whole turn (0 or +-360 degrees) that takes an angle `a`, read in
+/// `(-180, 180]`, to its copy nearest the arc `[lo, hi]`: the copy whose
+/// plain excursion ([`beyond_line`]) is the shorter way round to the arc.
+/// 0 while `a` is on the near side of the forbidden arc's middle (always,
+/// for a range symmetric about 0); -360 past the middle above `hi`, +360
+/// past it below `lo`. So an angle just across +-180 from a limit near it is
+/// that little beyond it, and the excursion is continuous where the reading
+/// wraps; a range reaching beyond +-180 holds the wrapped copy.
+#[inline(always)]
+pub fn arc_turn(a: f64, lo: f64, hi: f64) -> f64 {
+    if a > hi && lo + 360.0 - a < a - hi {
+        -360.0
+    } else if a < lo && a + 360.0 - hi < lo - a {
+        360.0
+    } else {
+        0.0
+    }
+}
+
+/// Excursion (degrees) of an angle `a` read on the circle beyond the arc
+/// `[lo, hi]`, the shorter way round ([`arc_turn`]), and its slope in `a`.
 #[inline(always)]
 pub fn beyond_arc_slope(a: f64, lo: f64, hi: f64) -> (f64, f64) {
-    let (direct, round, slope) = if a > hi {
-        (a - hi, lo + 360.0 - a, 1.0)
-    } else if a < lo {
-        (lo - a, a + 360.0 - hi, -1.0)
-    } else {
-        return (0.0, 0.0);
-    };
-    if round <= 0.0 {
-        (0.0, 0.0)
-    } else if round < direct {
-        (round, -slope)
-    } else {
-        (direct, slope)
-    }
+    beyond_line_slope(a + arc_turn(a, lo, hi), lo, hi)
 }
 
 /// The excursion of [`beyond_arc_slope`] alone, degrees.
 #[inline(always)]
 pub fn beyond_arc(a: f64, lo: f64, hi: f64) -> f64 {
-    beyond_arc_slope(a, lo, hi).0
+    beyond_line(a + arc_turn(a, lo, hi), lo, hi)
 }
 
 /// Excursion (degrees) of the middle angle `a` beyond `[lo, hi]`: `a - hi`
 /// above, `lo - a` below, 0 inside (it does not wrap).
 #[inline(always)]
 pub fn beyond_line(a: f64, lo: f64, hi: f64) -> f64 {
+    beyond_line_slope(a, lo, hi).0
+}
+
+/// [`beyond_line`] and its slope in `a`: +1 above the range, -1 below, 0
+/// inside.
+#[inline(always)]
+pub fn beyond_line_slope(a: f64, lo: f64, hi: f64) -> (f64, f64) {
     if a > hi {
-        a - hi
+        (a - hi, 1.0)
     } else if a < lo {
-        lo - a
+        (lo - a, -1.0)
     } else {
-        0.0
+        (0.0, 0.0)
     }
 }
 

@@ -1137,13 +1137,10 @@ fn solve_window_screened(
                 return found;
             }
             let stride = cost.len() / SCREEN_SAMPLES;
+            let thinned = (stride > 1).then(|| cost.coarse(stride));
+            let coarse = thinned.as_ref().unwrap_or(cost);
             let screen = (&opts, &ScreenOptions::default());
-            if stride > 1 {
-                let coarse = cost.coarse(stride);
-                screen_basins(&shaped, &|c| coarse.eval(c), found, screen)
-            } else {
-                screen_basins(&shaped, &|c| cost.eval(c), found, screen)
-            }
+            screen_basins(&shaped, &|c| coarse.eval(c), found, screen)
         }
     }
 }

@@ -11,26 +11,11 @@
 //! the samples that exceed a limit. The value is the same as the direct formula.
 
 use crate::limits::JointLimits;
-use crate::rotation::{angle_deg, euler_zyx_deg, quat_from_euler_zyx_deg, Quat};
+use crate::rotation::{
+    angle_deg, beyond_arc, beyond_arc_slope, beyond_line, beyond_line_slope, euler_zyx_deg,
+    quat_from_euler_zyx_deg, Quat,
+};
 use nalgebra::Vector3;
-
-/// Excursion of one angle `a` beyond `[lo, hi]` (degrees): `a - hi` above,
-/// `lo - a` below, 0 inside. The Z-Y-X middle angle's; the first and last
-/// are read on the circle ([`beyond_arc`]).
-pub use crate::rotation::beyond_line as beyond;
-use crate::rotation::{beyond_arc, beyond_arc_slope};
-
-/// [`beyond`] and its slope: +1 above the range, -1 below, 0 inside.
-#[inline(always)]
-fn beyond_slope(a: f64, lo: f64, hi: f64) -> (f64, f64) {
-    if a > hi {
-        (a - hi, 1.0)
-    } else if a < lo {
-        (lo - a, -1.0)
-    } else {
-        (0.0, 0.0)
-    }
-}
 
 /// Degrees per radian.
 const DEG: f64 = 180.0 / std::f64::consts::PI;
@@ -207,7 +192,7 @@ impl PitchRange {
         if r20 <= self.r20_max && r20 >= self.r20_min {
             return 0.0;
         }
-        beyond(-r20.clamp(-1.0, 1.0).asin().to_degrees(), self.lo, self.hi)
+        beyond_line(-r20.clamp(-1.0, 1.0).asin().to_degrees(), self.lo, self.hi)
     }
 
     #[inline(always)]
@@ -227,7 +212,7 @@ impl PitchRange {
         if r20 <= self.r20_max && r20 >= self.r20_min {
             return (0.0, 0.0);
         }
-        beyond_slope(-r20.clamp(-1.0, 1.0).asin().to_degrees(), self.lo, self.hi)
+        beyond_line_slope(-r20.clamp(-1.0, 1.0).asin().to_degrees(), self.lo, self.hi)
     }
 }
 
@@ -279,7 +264,7 @@ impl OtherPitch {
         } else {
             -180.0 - theta
         };
-        let (e, s) = beyond_slope(other, self.lo, self.hi);
+        let (e, s) = beyond_line_slope(other, self.lo, self.hi);
         (e, -s)
     }
 }
@@ -617,11 +602,6 @@ impl WindowCost {
     /// Prepares the cost for measured joint rotations `Rm_i` (parent to child).
     pub fn new(measured: &[Quat], limits: &JointLimits, lambda1: f64) -> Self {
         WindowCost::from_iter(measured.iter(), limits, lambda1)
-    }
-
-    /// As [`WindowCost::new`], taking every `stride`-th sample (a coarse copy).
-    pub fn strided(measured: &[Quat], stride: usize, limits: &JointLimits, lambda1: f64) -> Self {
-        WindowCost::from_iter(measured.iter().step_by(stride.max(1)), limits, lambda1)
     }
 
     /// A coarse copy of this cost: every `stride`-th of its samples, the

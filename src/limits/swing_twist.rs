@@ -215,7 +215,17 @@ impl SwingTwistLimits {
         let [l1, h1] = self.edge_twist_deg;
         let lo = S::from(l0) + S::from(l1 - l0) * f;
         let hi = S::from(h0) + S::from(h1 - h0) * f;
-        (swing_e, beyond_arc(tw, lo, hi), [s1.val(), s2.val()])
+        // The twist is an angle on the circle: its excursion is the shorter
+        // way round to the range, as the Euler box reads X and Z.
+        let tw = tw + S::from(crate::rotation::arc_turn(tw.val(), lo.val(), hi.val()));
+        let twist_e = if tw.val() > hi.val() {
+            tw - hi
+        } else if tw.val() < lo.val() {
+            lo - tw
+        } else {
+            S::from(0.0)
+        };
+        (swing_e, twist_e, [s1.val(), s2.val()])
     }
 
     /// The distance of a swing offset `p` from the centre (degrees) beyond
@@ -356,28 +366,6 @@ fn coordinates<S: Scalar>(t: usize, q: [S; 4]) -> [S; 3] {
 /// sample trials the nearer of the two to the table's Z-Y-X angles).
 pub fn twist_in_proximal(t: usize) -> bool {
     t == 2
-}
-
-/// Excursion (degrees) of a twist `a`, read in `(-180, 180]`, beyond the
-/// arc `[lo, hi]`, the shorter way round (as
-/// [`crate::rotation::beyond_arc_slope`] reads the Euler box's X and Z): an
-/// asymmetric range such as the elbow's `[0, 160]` has no jump where the
-/// reading wraps at +-180.
-fn beyond_arc<S: Scalar>(a: S, lo: S, hi: S) -> S {
-    let (direct, round) = if a.val() > hi.val() {
-        (a - hi, lo + S::from(360.0) - a)
-    } else if a.val() < lo.val() {
-        (lo - a, a + S::from(360.0) - hi)
-    } else {
-        return S::from(0.0);
-    };
-    if round.val() <= 0.0 {
-        S::from(0.0)
-    } else if round.val() < direct.val() {
-        round
-    } else {
-        direct
-    }
 }
 
 /// [`coordinates`] for `R = swing * twist`.
