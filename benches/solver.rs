@@ -8,6 +8,8 @@
 //!   steps; Nelder-Mead's are the previous ones), and against
 //!   `drift-centroid`: the gradient solver's (now) and Nelder-Mead's heading
 //!   fit against the gradient `drift-centroid` (before);
+//! - the basin screen alone: every window cost of the 5-minute trial
+//!   solved from the identity with and without it, one after the other;
 //! - a 2-hour trial against 24 times the 5-minute one, gradient solver;
 //! - peak heap during a `drift-centroid` correction of 5 min, 30 min and
 //!   2 h, as a multiple of the decoded orientations (samples x IMUs x 32 bytes).
@@ -18,6 +20,8 @@
 //! only the ratios of what ran. `SOLVER_BENCH_NO_MEMORY=1` leaves out the
 //! peak-heap figures (three more corrections, one of a 2-hour trial).
 
+use acm_workbench::acm::chain::solve_window_screened;
+use acm_workbench::acm::cost::WindowCost;
 use acm_workbench::acm::minimise::Solver;
 use acm_workbench::acm::{Correction, RunControl, Variant};
 use acm_workbench::correct::{correct_trial, recorrect};
@@ -26,6 +30,7 @@ use acm_workbench::model::Model;
 use acm_workbench::rotation::Quat;
 use acm_workbench::simulate::{simulate, SimConfig};
 use acm_workbench::trial::Trial;
+use acm_workbench::window::layout;
 use criterion::{criterion_group, criterion_main, Bencher, Criterion};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::collections::BTreeMap;
@@ -132,6 +137,32 @@ fn run(t: &Trial, variant: Variant, table: &LimitTable, solver: Solver) -> Corre
     .unwrap()
 }
 
+/// The window costs of every joint of `t` on its measured joint rotations
+/// (`infant13`'s joints with their centroids, the default layout and
+/// `lambda1`).
+fn window_costs(t: &Trial, table: &LimitTable) -> Vec<WindowCost> {
+    let model = Model::infant13();
+    let s = Settings::default();
+    let windows = layout(&t.time_s, s.window_s, s.hop_s);
+    let mut costs = Vec::new();
+    for joint in &model.joints {
+        let (Some(p), Some(d), Some(limits)) = (
+            t.imu(&joint.proximal),
+            t.imu(&joint.distal),
+            table.cost_limits(joint, true),
+        ) else {
+            continue;
+        };
+        let rm: Vec<Quat> = (p.orientation.iter().zip(&d.orientation))
+            .map(|(p, d)| p.inverse() * d)
+            .collect();
+        for w in &windows {
+            costs.push(WindowCost::new(&rm[w.first..w.end], &limits, s.lambda1));
+        }
+    }
+    costs
+}
+
 /// The default table with the left knee's flexion range narrowed to 20-60 deg.
 fn edited_table() -> LimitTable {
     let mut table = LimitTable::default_table();
@@ -219,6 +250,28 @@ fn benches(c: &mut Criterion) {
             })
         });
     }
+    // The basin screen alone: every window of every joint of the 5-minute
+    // trial (measured joint rotations, default table), solved one after the
+    // other from the identity, with and without the screen.
+    let costs = window_costs(&five, &table);
+    for screen in [false, true] {
+        let name = format!(
+            "window solves, screen {}",
+            if screen { "on" } else { "off" }
+        );
+        g.bench_function(&name, |b| {
+            timed(b, &name, || {
+                for cost in &costs {
+                    std::hint::black_box(solve_window_screened(
+                        cost,
+                        &[Quat::identity()],
+                        Solver::Gradient,
+                        screen,
+                    ));
+                }
+            })
+        });
+    }
     let name = "Gradient drift-centroid 2 h";
     g.bench_function(name, |b| {
         let t = two_hours();
@@ -240,6 +293,16 @@ fn benches(c: &mut Criterion) {
         if let (Some(a), Some(b), Some(r)) = (mean_s(&nm), mean_s(&gr), ratio(&nm, &gr)) {
             eprintln!("{what}: Nelder-Mead {a:.3} s, gradient {b:.3} s: {r:.2}x faster");
         }
+    }
+    if let (Some(on), Some(off)) = (
+        mean_s("window solves, screen on"),
+        mean_s("window solves, screen off"),
+    ) {
+        eprintln!(
+            "window solves of the 5-min trial ({} windows), with / without the basin screen: {on:.3} s / {off:.3} s = {:.2}",
+            window_costs(&five, &table).len(),
+            on / off
+        );
     }
     for solver in ["Gradient", "NelderMead"] {
         let heading = format!("{solver} drift-heading-centroid 5 min");

@@ -394,12 +394,18 @@ fn hinge_text(out: &mut String, v: &VariantReport) {
             }
         };
         let n = h.windows.len();
+        let pooled = h.windows.iter().filter(|w| w.pooled).count();
         let _ = writeln!(
             out,
-            "{joint:<14} hinge {:<4} {p}/{n} | {d}/{n} windows; tilt {} | {}{}",
+            "{joint:<14} hinge {:<4} {p}/{n} | {d}/{n} windows; tilt {} | {}{}{}",
             h.hinge,
             mean(&|w| w.proximal_tilt_deg),
             mean(&|w| w.distal_tilt_deg),
+            if pooled > 0 {
+                format!("; {pooled} windows took axes pooled with their neighbours")
+            } else {
+                String::new()
+            },
             if h.proximal_turned_by_axis {
                 "; proximal IMU turned by the axis alone (no joint above corrects it)"
             } else {

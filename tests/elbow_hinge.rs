@@ -195,16 +195,21 @@ fn full_body_knees_and_elbows() {
                 // keeps what of the forearm's turn about its flexion axis the
                 // limits 0..160 do not reach over the trial (the held turn).
                 // full_body_drift's right upper arm drifts in heading: its
-                // joint rotations leave the two-axis model within a window.
-                // Seed 4's left elbow has both axes 5-7 deg off (its upper
-                // arm's axis is seen only through +-30 deg of pronation); the
-                // drifting upper arm's axis is 20 deg off (X 7.07 there, at
-                // most 2.2 elsewhere).
+                // joint rotations leave the two-axis model within a window,
+                // whose axis ends 14 deg off (X 7.01 there, at most 2.1
+                // elsewhere). Seed 4's left elbow had both axes 5-7 deg off
+                // in single windows (2.19 / 2.28) before the windows pooled
+                // their axes (0.46 / 0.51: 0.98 / 1.49).
                 let (x_bound, z_bound) = match (label.as_str(), joint) {
                     ("full_body_drift", "r_elbow") => (7.5, 4.5),
-                    ("seed 4", "l_elbow") => (7.0, 2.5),
                     _ => (7.0, 2.0),
                 };
+                // The windows pool their axes: within 0.51 deg in the worst
+                // window but on the drifting upper arm (each window's own
+                // fit: up to 6.6 deg).
+                if (label.as_str(), joint) != ("full_body_drift", "r_elbow") {
+                    assert!(ax[0].max(ax[1]) < 1.0, "{label} {joint}: axes {ax:?}");
+                }
                 assert!(hz <= z_bound, "{label} {joint}: Z {hz}");
                 assert!(hx <= x_bound, "{label} {joint}: X {hx}");
                 elbows_within_2 += usize::from(hx <= 2.0 && hz <= 2.0);
@@ -221,9 +226,10 @@ fn full_body_knees_and_elbows() {
     eprintln!(
         "elbows, sum of RMS X and Z: hinge {sum_h:.1}, drift-centroid {sum_d:.1} deg; {elbows_within_2} of 12 within 2 deg on both"
     );
-    // Windows on their own (each turn from 0): 3 of 12, sum 62 of 136.
+    // Windows on their own (each turn from 0): 3 of 12, sum 62 of 136; with
+    // the held turn but each window's own axes: 9 of 12, sum 35.9 of 126.
     assert!(
-        elbows_within_2 >= 9,
+        elbows_within_2 >= 10,
         "{elbows_within_2} of 12 elbows within 2 deg"
     );
     assert!(sum_h < 0.4 * sum_d, "{sum_h} vs {sum_d}");

@@ -1116,8 +1116,9 @@ pub fn solve_window(cost: &WindowCost, starts: &[Quat], solver: Solver) -> Solut
     solve_window_screened(cost, starts, solver, true)
 }
 
-/// [`solve_window`], the gradient solver's screen only when `screen`.
-fn solve_window_screened(
+/// [`solve_window`], the gradient solver's screen only when `screen` (the
+/// chain screens its first pass's descents, not its second's).
+pub fn solve_window_screened(
     cost: &WindowCost,
     starts: &[Quat],
     solver: Solver,

@@ -74,6 +74,10 @@ pub struct HingeWindow {
     /// window (max minus min), degrees.
     pub proximal_range_deg: f64,
     pub distal_range_deg: f64,
+    /// True when the window took the axes fitted on all the windows that
+    /// agree with them (a two-axis hinge; see `pool_two_axes`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub pooled: bool,
     /// Why an axis was not used in this window (none: both were).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback: Option<String>,
@@ -150,6 +154,10 @@ pub fn estimate_windows(
             estimate_window(hinge, w.centre_s, &rm[span.clone()], &rates[span])
         })
         .unzip();
+    let (mut fits, mut axes) = (fits, axes);
+    if let Hinge::Two { .. } = hinge {
+        pool_two_axes(hinge, rm, &rates, windows, (&mut fits, &mut axes));
+    }
     HingeFits {
         hinge,
         record: HingeRecord {
@@ -159,6 +167,109 @@ pub fn estimate_windows(
             proximal_turned_by_axis: false,
         },
         axes,
+    }
+}
+
+/// Most samples of a pooled two-axis fit (evenly spaced).
+const POOL_MAX_SAMPLES: usize = 6000;
+/// How much larger a window's sum of squared plane residuals may be at the
+/// pooled axes than at its own for the window to join the pool.
+pub const POOL_TOLERANCE: f64 = 0.1;
+
+/// A two-axis hinge's axes: proximal frame, distal frame (unit).
+type AxisPair = (Vector3<f64>, Vector3<f64>);
+
+/// One window's own two-axis fit: its axes, its samples and their sum of
+/// squared residuals at those axes.
+struct OwnFit {
+    axes: AxisPair,
+    samples: PlaneSamples,
+    sum_sq: f64,
+}
+
+/// Pools a two-axis hinge's windows: an IMU that stays put on its segment
+/// has the same axes in every window, and one window's plane fit (a minute
+/// of elbow movement whose held angle is not quite held) scatters by several
+/// degrees about them. Consecutive windows where both axes were observed are
+/// gathered into runs, a run growing by the next window as long as the axes
+/// fitted on all of the run's samples fit each of its windows within
+/// [`POOL_TOLERANCE`] of that window's own fit; every window of a run of two
+/// or more takes the run's axes. Where the axes move (a strap slips, a
+/// heading drifts) runs stay short and windows keep axes of their own time.
+fn pool_two_axes(
+    hinge: Hinge,
+    rm: &[Quat],
+    rates: &[Vector3<f64>],
+    windows: &[Window],
+    (records, axes): (&mut [HingeWindow], &mut [WindowAxes]),
+) {
+    let opts = MuellerOptions::default();
+    let own: Vec<Option<OwnFit>> = (axes.iter())
+        .zip(windows)
+        .map(|(ax, w)| {
+            let own = (ax.proximal?, ax.distal?);
+            let span = w.first..w.end;
+            let samples =
+                PlaneSamples::new(&rm[span.clone()], &rates[span], &opts, REFINE_MAX_SAMPLES)?;
+            let sum_sq = samples.sum_sq(&own.0, &own.1);
+            Some(OwnFit {
+                axes: own,
+                samples,
+                sum_sq,
+            })
+        })
+        .collect();
+    let fit_run = |run: &[usize], start: AxisPair| {
+        let (first, end) = (windows[run[0]].first, windows[*run.last()?].end);
+        let all = PlaneSamples::new(&rm[first..end], &rates[first..end], &opts, POOL_MAX_SAMPLES)?;
+        let (a, b, _) = all.fit(start);
+        let agree = run.iter().all(|&k| {
+            let mine = own[k].as_ref().expect("observed");
+            mine.samples.sum_sq(&a, &b) <= (1.0 + POOL_TOLERANCE) * mine.sum_sq
+        });
+        agree.then_some((a, b))
+    };
+    let mut runs: Vec<(Vec<usize>, AxisPair)> = Vec::new();
+    let mut run: Vec<usize> = Vec::new();
+    let mut pooled = None;
+    for (k, mine) in own.iter().enumerate() {
+        let Some(mine) = mine else {
+            runs.extend(pooled.take().map(|p| (std::mem::take(&mut run), p)));
+            run.clear();
+            continue;
+        };
+        run.push(k);
+        if run.len() == 1 {
+            continue;
+        }
+        let start = pooled.unwrap_or(mine.axes);
+        match fit_run(&run, start) {
+            Some(p) => pooled = Some(p),
+            None => {
+                run.pop();
+                runs.extend(pooled.take().map(|p| (std::mem::take(&mut run), p)));
+                run = vec![k];
+            }
+        }
+    }
+    runs.extend(pooled.map(|p| (run, p)));
+    let (np, nd) = hinge.segment_axes();
+    let (np, nd) = (Vector3::from(np), Vector3::from(nd));
+    for (run, (a, b)) in runs {
+        let a = if a.dot(&np) < 0.0 { -a } else { a };
+        let b = if b.dot(&nd) < 0.0 { -b } else { b };
+        for k in run {
+            axes[k] = WindowAxes {
+                proximal: Some(a),
+                distal: Some(b),
+            };
+            let r = &mut records[k];
+            r.proximal_axis = Some(a.into());
+            r.distal_axis = Some(b.into());
+            r.proximal_tilt_deg = Some(angle_between_axes_deg(&a, &np));
+            r.distal_tilt_deg = Some(angle_between_axes_deg(&b, &nd));
+            r.pooled = true;
+        }
     }
 }
 
@@ -186,6 +297,7 @@ pub fn estimate_window(
             proximal_range_deg: 0.0,
             distal_range_deg: 0.0,
             fallback: Some("the joint hardly moved: no axis to estimate".into()),
+            pooled: false,
         };
         let none = WindowAxes {
             proximal: None,
@@ -220,6 +332,7 @@ pub fn estimate_window(
         proximal_range_deg: range_p,
         distal_range_deg: range_d,
         fallback: (!reasons.is_empty()).then(|| reasons.join("; ")),
+        pooled: false,
     };
     (record, axes)
 }
@@ -345,83 +458,127 @@ pub fn refine_two_axes(
     start: (Vector3<f64>, Vector3<f64>),
     opts: &MuellerOptions,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let min_rate = opts.min_rate_deg_s.to_radians();
-    let moving: Vec<usize> = (0..rm.len().min(rates.len()))
-        .filter(|&k| rates[k].norm() > min_rate)
-        .collect();
-    let (mut a, mut b) = (start.0.normalize(), start.1.normalize());
-    if moving.len() < 10 {
-        return (a, b);
+    let start = (start.0.normalize(), start.1.normalize());
+    match PlaneSamples::new(rm, rates, opts, REFINE_MAX_SAMPLES) {
+        Some(samples) => {
+            let (a, b, _) = samples.fit(start);
+            (a, b)
+        }
+        None => start,
     }
-    let stride = moving.len().div_ceil(REFINE_MAX_SAMPLES);
-    let samples: Vec<(Matrix3<f64>, Vector3<f64>)> = (moving.iter().step_by(stride))
-        .map(|&k| (*rm[k].to_rotation_matrix().matrix(), rates[k]))
-        .collect();
-    // The held angle's prior: `a . Rm b` (the cosine of the angle between the
-    // axes, zero when the held angle is) as one residual per sample, scaled to
-    // the RMS rate.
-    let rms_rate =
-        (samples.iter().map(|(_, w)| w.norm_squared()).sum::<f64>() / samples.len() as f64).sqrt();
-    let held_weight = HELD_ANGLE_WEIGHT * rms_rate;
-    let step = |a: &Vector3<f64>, b: &Vector3<f64>, d: &nalgebra::Vector4<f64>| {
-        let (ua, va) = tangent_basis(a);
-        let (ub, vb) = tangent_basis(b);
-        (
-            (a + ua * d[0] + va * d[1]).normalize(),
-            (b + ub * d[2] + vb * d[3]).normalize(),
-        )
-    };
-    let (mut r, mut moved) = (Vec::new(), Vec::new());
-    plane_residuals(&samples, held_weight, &a, &b, &mut r);
-    let sum_sq = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
-    let mut f = sum_sq(&r);
-    let mut mu = 1e-3;
-    let h = 1e-7;
-    for _ in 0..REFINE_ITERATIONS {
-        // Forward-difference Jacobian, one column per tangent angle.
-        let mut jac = vec![nalgebra::Vector4::<f64>::zeros(); r.len()];
-        for p in 0..4 {
-            let mut d = nalgebra::Vector4::zeros();
-            d[p] = h;
-            let (a2, b2) = step(&a, &b, &d);
-            plane_residuals(&samples, held_weight, &a2, &b2, &mut moved);
-            for (j, (m, r0)) in jac.iter_mut().zip(moved.iter().zip(&r)) {
-                j[p] = (m - r0) / h;
-            }
+}
+
+/// The samples of a two-axis fit: per moving sample (relative rate above the
+/// minimum, evenly spaced) the joint rotation as a matrix and the relative
+/// rate (rad/s, proximal frame), with the weight of the held angle's prior.
+struct PlaneSamples {
+    samples: Vec<(Matrix3<f64>, Vector3<f64>)>,
+    held_weight: f64,
+}
+
+impl PlaneSamples {
+    /// At most `max` of the moving samples; none when fewer than 10 move.
+    fn new(
+        rm: &[Quat],
+        rates: &[Vector3<f64>],
+        opts: &MuellerOptions,
+        max: usize,
+    ) -> Option<PlaneSamples> {
+        let min_rate = opts.min_rate_deg_s.to_radians();
+        let moving: Vec<usize> = (0..rm.len().min(rates.len()))
+            .filter(|&k| rates[k].norm() > min_rate)
+            .collect();
+        if moving.len() < 10 {
+            return None;
         }
-        let mut jtj = nalgebra::Matrix4::<f64>::zeros();
-        let mut jtr = nalgebra::Vector4::<f64>::zeros();
-        for (j, r0) in jac.iter().zip(&r) {
-            jtj += j * j.transpose();
-            jtr += j * *r0;
-        }
-        let mut improved = false;
-        for _ in 0..30 {
-            let mut m = jtj;
+        let stride = moving.len().div_ceil(max);
+        let samples: Vec<(Matrix3<f64>, Vector3<f64>)> = (moving.iter().step_by(stride))
+            .map(|&k| (*rm[k].to_rotation_matrix().matrix(), rates[k]))
+            .collect();
+        // The held angle's prior: `a . Rm b` (the cosine of the angle between
+        // the axes, zero when the held angle is) as one residual per sample,
+        // scaled to the RMS rate.
+        let rms_rate = (samples.iter().map(|(_, w)| w.norm_squared()).sum::<f64>()
+            / samples.len() as f64)
+            .sqrt();
+        Some(PlaneSamples {
+            samples,
+            held_weight: HELD_ANGLE_WEIGHT * rms_rate,
+        })
+    }
+
+    /// The sum of squared residuals at axes `a`, `b` (see [`plane_residuals`]).
+    fn sum_sq(&self, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+        let mut r = Vec::new();
+        plane_residuals(&self.samples, self.held_weight, a, b, &mut r);
+        r.iter().map(|x| x * x).sum()
+    }
+
+    /// Gauss-Newton with Levenberg-Marquardt damping from unit axes `start`
+    /// (see [`refine_two_axes`]): the axes and their sum of squares.
+    fn fit(&self, start: (Vector3<f64>, Vector3<f64>)) -> (Vector3<f64>, Vector3<f64>, f64) {
+        let (samples, held_weight) = (&self.samples, self.held_weight);
+        let (mut a, mut b) = start;
+        let step = |a: &Vector3<f64>, b: &Vector3<f64>, d: &nalgebra::Vector4<f64>| {
+            let (ua, va) = tangent_basis(a);
+            let (ub, vb) = tangent_basis(b);
+            (
+                (a + ua * d[0] + va * d[1]).normalize(),
+                (b + ub * d[2] + vb * d[3]).normalize(),
+            )
+        };
+        let (mut r, mut moved) = (Vec::new(), Vec::new());
+        plane_residuals(samples, held_weight, &a, &b, &mut r);
+        let sum_sq = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
+        let mut f = sum_sq(&r);
+        let mut mu = 1e-3;
+        let h = 1e-7;
+        for _ in 0..REFINE_ITERATIONS {
+            // Forward-difference Jacobian, one column per tangent angle.
+            let mut jac = vec![nalgebra::Vector4::<f64>::zeros(); r.len()];
             for p in 0..4 {
-                m[(p, p)] += mu * jtj[(p, p)] + 1e-12;
+                let mut d = nalgebra::Vector4::zeros();
+                d[p] = h;
+                let (a2, b2) = step(&a, &b, &d);
+                plane_residuals(samples, held_weight, &a2, &b2, &mut moved);
+                for (j, (m, r0)) in jac.iter_mut().zip(moved.iter().zip(&r)) {
+                    j[p] = (m - r0) / h;
+                }
             }
-            let Some(inv) = m.try_inverse() else {
+            let mut jtj = nalgebra::Matrix4::<f64>::zeros();
+            let mut jtr = nalgebra::Vector4::<f64>::zeros();
+            for (j, r0) in jac.iter().zip(&r) {
+                jtj += j * j.transpose();
+                jtr += j * *r0;
+            }
+            let mut improved = false;
+            for _ in 0..30 {
+                let mut m = jtj;
+                for p in 0..4 {
+                    m[(p, p)] += mu * jtj[(p, p)] + 1e-12;
+                }
+                let Some(inv) = m.try_inverse() else {
+                    mu *= 10.0;
+                    continue;
+                };
+                let (a2, b2) = step(&a, &b, &(-(inv * jtr)));
+                plane_residuals(samples, held_weight, &a2, &b2, &mut moved);
+                let f2 = sum_sq(&moved);
+                if f2 < f {
+                    improved = f - f2 > 1e-12 * f;
+                    (a, b, f) = (a2, b2, f2);
+                    std::mem::swap(&mut r, &mut moved);
+                    mu = (mu * 0.3).max(1e-9);
+                    break;
+                }
                 mu *= 10.0;
-                continue;
-            };
-            let (a2, b2) = step(&a, &b, &(-(inv * jtr)));
-            plane_residuals(&samples, held_weight, &a2, &b2, &mut moved);
-            let f2 = sum_sq(&moved);
-            if f2 < f {
-                improved = f - f2 > 1e-12 * f;
-                (a, b, f) = (a2, b2, f2);
-                std::mem::swap(&mut r, &mut moved);
-                mu = (mu * 0.3).max(1e-9);
+            }
+            if !improved {
                 break;
             }
-            mu *= 10.0;
         }
-        if !improved {
-            break;
-        }
+        (a, b, f)
     }
-    (a, b)
 }
 
 /// Turn of `q` about the unit axis `u` (its twist), degrees in [-180, 180).
@@ -680,6 +837,83 @@ mod tests {
         let ap = axes.proximal.unwrap();
         assert!(angle_between_axes_deg(&ap, &want_a) < 1.0);
         assert!(angle_between_axes_deg(&axes.distal.unwrap(), &want_b) < 1.0);
+    }
+
+    /// An elbow over `t` whose Y turns +-5 deg with zero mean, the upper
+    /// arm's sensor `ma(s)` and the forearm's `mb` off their hinge axes.
+    fn elbow(t: &[f64], ma: &dyn Fn(f64) -> Quat, mb: Quat) -> Vec<Quat> {
+        (t.iter())
+            .map(|&s| {
+                let flex = 70.0 + 60.0 * (1.3 * s).sin();
+                let pro = 25.0 * (0.7 * s + 1.0).sin();
+                let y = 5.0 * (2.3 * s + 0.4).sin() * (0.11 * s).cos();
+                ma(s).inverse() * quat_from_euler_zyx_deg([flex, y, pro]) * mb
+            })
+            .collect()
+    }
+
+    #[test]
+    fn windows_that_agree_take_the_axes_fitted_on_all_of_them() {
+        // 5 min, 60-s windows every 30 s, both sensors fixed: every window
+        // pools, and the pooled axes are closer to the truth than the worst
+        // window's own.
+        let ma = quat_axis_angle_deg([1.0, 1.0, 0.0], 20.0);
+        let mb = quat_axis_angle_deg([0.0, 1.0, -1.0], 20.0);
+        let t: Vec<f64> = (0..15000).map(|i| f64::from(i) * 0.02).collect();
+        let rm = elbow(&t, &|_| ma, mb);
+        let rates = rates_from_orientations(&t, &rm, 0.05);
+        let w = crate::window::layout(&t, 60.0, 30.0);
+        let hinge = Hinge::two_axes_holding(crate::model::Axis::Y);
+        let fits = estimate_windows(hinge, &t, &rm, None, &w);
+        let (want_a, want_b) = (ma.inverse() * Vector3::z(), mb.inverse() * Vector3::x());
+        let own_worst = (w.iter())
+            .map(|w| {
+                let (_, ax) =
+                    estimate_window(hinge, 0.0, &rm[w.first..w.end], &rates[w.first..w.end]);
+                angle_between_axes_deg(&ax.proximal.unwrap(), &want_a)
+                    .max(angle_between_axes_deg(&ax.distal.unwrap(), &want_b))
+            })
+            .fold(0.0, f64::max);
+        assert!(fits.record.windows.iter().all(|r| r.pooled));
+        let ax = fits.axes[0];
+        let pooled = angle_between_axes_deg(&ax.proximal.unwrap(), &want_a)
+            .max(angle_between_axes_deg(&ax.distal.unwrap(), &want_b));
+        assert!(
+            pooled < 0.5 && pooled < own_worst,
+            "{pooled} vs {own_worst}"
+        );
+        assert!(fits.axes.iter().all(|a| a.proximal == ax.proximal));
+    }
+
+    #[test]
+    fn a_strap_that_slips_splits_the_pool() {
+        // The upper arm's sensor turns by 15 deg about its long axis's
+        // normal half way through: no window before the slip shares axes
+        // with one after it, and the windows on each side keep axes of their
+        // own side (those before within 2.4 deg: the window across the slip
+        // joins their run and brings some of the new axes).
+        let before = quat_axis_angle_deg([1.0, 1.0, 0.0], 20.0);
+        let after = quat_axis_angle_deg([1.0, 0.0, 0.0], 15.0) * before;
+        let ma = move |s: f64| if s < 150.0 { before } else { after };
+        let mb = quat_axis_angle_deg([0.0, 1.0, -1.0], 20.0);
+        let t: Vec<f64> = (0..15000).map(|i| f64::from(i) * 0.02).collect();
+        let rm = elbow(&t, &ma, mb);
+        let w = crate::window::layout(&t, 60.0, 30.0);
+        let hinge = Hinge::two_axes_holding(crate::model::Axis::Y);
+        let fits = estimate_windows(hinge, &t, &rm, None, &w);
+        for (win, ax) in w.iter().zip(&fits.axes) {
+            let a = ax.proximal.unwrap();
+            if win.end_s <= 150.0 {
+                let e = angle_between_axes_deg(&a, &(before.inverse() * Vector3::z()));
+                assert!(e < 3.0, "before the slip, window at {}: {e}", win.centre_s);
+            } else if win.start_s >= 150.0 {
+                let e = angle_between_axes_deg(&a, &(after.inverse() * Vector3::z()));
+                assert!(e < 1.0, "after the slip, window at {}: {e}", win.centre_s);
+            }
+        }
+        let first = fits.axes[0].proximal.unwrap();
+        let last = fits.axes[w.len() - 1].proximal.unwrap();
+        assert!(angle_between_axes_deg(&first, &last) > 10.0);
     }
 
     #[test]
