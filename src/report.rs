@@ -361,7 +361,7 @@ pub fn format_text(r: &TrialReport) -> String {
             },
         );
     }
-    for v in r.variants.iter().filter(|v| v.variant.heading()) {
+    for v in r.variants.iter().filter(|v| v.variant.fits_headings()) {
         heading_table(&mut out, v);
     }
     for v in r.variants.iter().filter(|v| !v.hinges.is_empty()) {

@@ -17,6 +17,8 @@ pub enum Variant {
     DriftHeadingCentroid,
     Ik,
     Hinge,
+    /// `hinge` after removing the heading drift `drift-heading-centroid` finds.
+    HingeHeading,
     /// Per joint, the ACM variant its own figures favour (`acm::auto`).
     Auto,
     None,
@@ -61,6 +63,9 @@ pub struct VariantInfo {
     pub centroid: bool,
     /// Estimates the hinge joints' axes and corrects both of their IMUs with them.
     pub hinge: bool,
+    /// Removes each IMU's heading drift, as `drift-heading-centroid`
+    /// estimates it, from the trial before correcting it.
+    pub headings_first: bool,
     /// One line for `--help` and the help screen.
     pub description: &'static str,
 }
@@ -71,7 +76,7 @@ const fn row(
     short: &'static str,
     column: &'static str,
     kind: Kind,
-    (windowed, centroid, hinge): (bool, bool, bool),
+    (windowed, centroid, hinge, headings_first): (bool, bool, bool, bool),
     description: &'static str,
 ) -> VariantInfo {
     VariantInfo {
@@ -83,6 +88,7 @@ const fn row(
         windowed,
         centroid,
         hinge,
+        headings_first,
         description,
     }
 }
@@ -95,7 +101,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "basic",
         "basic",
         Kind::Acm,
-        (false, false, false),
+        (false, false, false, false),
         "One correction per joint for the whole trial, no centroid term.",
     ),
     row(
@@ -104,7 +110,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "drift",
         "drift",
         Kind::Acm,
-        (true, false, false),
+        (true, false, false, false),
         "Windows + slerp to follow drift, no centroid term (lambda2 = 0).",
     ),
     row(
@@ -113,7 +119,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "d+c",
         "drift-centroid",
         Kind::Acm,
-        (true, true, false),
+        (true, true, false, false),
         "Windows + slerp + the centroid term (lambda2 from the table).",
     ),
     row(
@@ -122,7 +128,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "d+h",
         "drift-heading",
         Kind::Heading,
-        (true, false, false),
+        (true, false, false, false),
         "One constant correction per IMU plus a heading correction about the \
          global vertical per window: `G_R' = R_up(-h(t)) G_R C`; no centroid term.",
     ),
@@ -132,7 +138,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "d+h+c",
         "drift-hdg-cent",
         Kind::Heading,
-        (true, true, false),
+        (true, true, false, false),
         "As `drift-heading`, with the centroid term.",
     ),
     row(
@@ -141,7 +147,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "rivest",
         "rivest",
         Kind::Baseline,
-        (true, true, false),
+        (true, true, false, false),
         "Rivest (2005) for the knees, per drift window; `drift-centroid` elsewhere.",
     ),
     row(
@@ -150,7 +156,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "muell",
         "mueller",
         Kind::Baseline,
-        (true, true, false),
+        (true, true, false, false),
         "Mueller et al. (2017) axes for the elbows; `drift-centroid` elsewhere.",
     ),
     row(
@@ -159,7 +165,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "ik",
         "ik",
         Kind::Ik,
-        (false, false, false),
+        (false, false, false, false),
         "IMU inverse kinematics: joint coordinates with the model's degrees of \
          freedom and hard limits; not the ACM.",
     ),
@@ -169,10 +175,21 @@ pub const VARIANTS: &[VariantInfo] = &[
         "hinge",
         "hinge",
         Kind::Acm,
-        (true, true, true),
+        (true, true, true, false),
         "As `drift-centroid`, with the hinge axes of the model's hinge joints \
          estimated in both IMUs' frames: they fix two degrees of freedom of \
          the distal IMU's correction and of the proximal one's.",
+    ),
+    row(
+        Variant::HingeHeading,
+        "hinge-heading",
+        "hng+h",
+        "hinge-heading",
+        Kind::Acm,
+        (true, true, true, true),
+        "`hinge` on the trial with each IMU's heading drift removed as \
+         `drift-heading-centroid` estimates it: `G_R' = R_up(-h(t)) G_R C(t)`, \
+         for hinges whose proximal IMU drifts in heading.",
     ),
     row(
         Variant::Auto,
@@ -180,7 +197,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "auto",
         "auto",
         Kind::Auto,
-        (true, false, false),
+        (true, false, false, false),
         "Per joint in chain order, the one of drift-heading-centroid, \
          drift-heading, drift-centroid, drift and none that keeps the joint \
          inside its limits with the steadiest correction (docs/method.md section 19); \
@@ -192,7 +209,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "none",
         "none",
         Kind::None,
-        (false, false, false),
+        (false, false, false, false),
         "No correction: the trial as read, after any pose or functional \
          calibration (the step before every other variant).",
     ),
@@ -203,7 +220,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         "b+c",
         "basic-centroid",
         Kind::Acm,
-        (false, true, false),
+        (false, true, false, false),
         "As `basic`, with the centroid term (a demonstration variant).",
     ),
 ];
@@ -261,6 +278,17 @@ impl Variant {
     /// Estimates the hinge joints' axes and corrects both of their IMUs with them.
     pub fn hinge(self) -> bool {
         self.info().hinge
+    }
+
+    /// Removes each IMU's estimated heading drift before correcting.
+    pub fn headings_first(self) -> bool {
+        self.info().headings_first
+    }
+
+    /// Reports a heading drift per IMU (the heading kind, and the variants
+    /// that remove it first).
+    pub fn fits_headings(self) -> bool {
+        self.heading() || self.headings_first()
     }
 }
 

@@ -16,7 +16,7 @@
 //! its joint rotations are measured from.
 
 use super::cost::WindowCost;
-use super::heading::{apply, heading_series, HeadingOptions, HeadingProblem};
+use super::heading::{apply, heading_series, remove_headings, HeadingOptions, HeadingProblem};
 use super::hinge::{self, AxisFamily, HingeFits};
 use super::lookahead::{ChildJoint, Lookahead};
 use super::minimise::{
@@ -56,7 +56,63 @@ pub fn correct_chain(
     variant: Variant,
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
+    if variant.headings_first() {
+        return correct_deheaded(trial, model, limits, settings, variant, control);
+    }
     run(trial, model, limits, settings, variant, None, control)
+}
+
+/// A variant that removes heading drift first (`hinge-heading`): each IMU's
+/// heading drift as `drift-heading-centroid` estimates it is removed from the
+/// trial ([`remove_headings`]), and `hinge` corrects what is left; the result
+/// carries those headings. Both passes solve the same joints over the same
+/// windows, so progress counts each as half of the run.
+fn correct_deheaded(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    settings: &Settings,
+    variant: Variant,
+    control: &RunControl,
+) -> Result<Correction, Cancelled> {
+    let report = |done: usize, total: usize| {
+        if let Some(p) = control.progress {
+            p(done, total)
+        }
+    };
+    let first = |d: usize, n: usize| report(d, 2 * n);
+    let pass = RunControl {
+        cancel: control.cancel,
+        progress: Some(&first),
+    };
+    let headings = run(
+        trial,
+        model,
+        limits,
+        settings,
+        Variant::DriftHeadingCentroid,
+        None,
+        &pass,
+    )?
+    .headings;
+    let deheaded = remove_headings(trial, &headings);
+    let second = |d: usize, n: usize| report(n + d, 2 * n);
+    let pass = RunControl {
+        cancel: control.cancel,
+        progress: Some(&second),
+    };
+    let mut c = run(
+        &deheaded,
+        model,
+        limits,
+        settings,
+        Variant::Hinge,
+        None,
+        &pass,
+    )?;
+    c.variant = variant;
+    c.headings = headings;
+    Ok(c)
 }
 
 /// The `none` variant: the trial as it is, every joint left uncorrected (the
@@ -90,8 +146,9 @@ pub fn uncorrected(
 /// Re-corrects the named joints and everything below them, reusing `previous`
 /// for the rest (after a limit edit, say). For the heading variants the joint
 /// above each named one is redone too, with everything below it: its IMU's fit
-/// looks ahead at the named joint's limits ([`super::lookahead`]). `previous`
-/// must come from the same trial, model and variant, one of the chain's kinds.
+/// looks ahead at the named joint's limits ([`super::lookahead`]); a variant
+/// that removes heading drift first is redone whole. `previous` must come
+/// from the same trial, model and variant, one of the chain's kinds.
 pub fn recorrect_chain(
     trial: &Trial,
     model: &Model,
@@ -101,6 +158,10 @@ pub fn recorrect_chain(
     joints: &[&str],
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
+    if previous.variant.headings_first() {
+        // The headings are fitted with every joint's limits: all is redone.
+        return correct_chain(trial, model, limits, settings, previous.variant, control);
+    }
     let mut redo = BTreeSet::new();
     for (k, j) in model.joints.iter().enumerate() {
         if joints.contains(&j.name.as_str()) {

@@ -38,8 +38,10 @@ use super::minimise::{
 };
 use super::parent_cost::ParentCost;
 use super::window::Window;
+use super::ImuHeading;
 use crate::limits::JointLimits;
 use crate::rotation::Quat;
+use crate::trial::Trial;
 use crate::vertical::Vertical;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -729,6 +731,26 @@ pub fn heading_series(time_s: &[f64], centres_s: &[f64], headings_deg: &[f64]) -
             headings_deg[k] + f * (headings_deg[k + 1] - headings_deg[k])
         })
         .collect()
+}
+
+/// `trial` with each fitted IMU's heading drift removed, `R_up(-h(t)) G_R(t)`,
+/// `h(t)` its [`heading_series`] (the fits' constant corrections are not
+/// applied). Gyroscope readings (sensor frame) are kept: the drift's own rate,
+/// a fraction of a degree per second, is left out as in the heading variants.
+pub fn remove_headings(trial: &Trial, headings: &[ImuHeading]) -> Trial {
+    let mut out = trial.clone();
+    for h in headings {
+        let Some(imu) = out.imu_mut(&h.imu).filter(|_| !h.windows.is_empty()) else {
+            continue;
+        };
+        let centres: Vec<f64> = h.windows.iter().map(|w| w.centre_s).collect();
+        let degrees: Vec<f64> = h.windows.iter().map(|w| w.heading_deg).collect();
+        let series = heading_series(&trial.time_s, &centres, &degrees);
+        for (q, &d) in imu.orientation.iter_mut().zip(&series) {
+            *q = Quat::new_normalize((h.vertical.heading_rotation(-d) * *q).into_inner());
+        }
+    }
+    out
 }
 
 /// The corrected distal orientations `R_up(-h(t)) * G_R_dist(t) * C`.

@@ -3,7 +3,6 @@
 use crate::acm::Correction;
 use crate::rotation::Quat;
 use crate::trial::{ImuSeries, Trial};
-use crate::variant::Kind;
 use crate::vertical::Vertical;
 
 /// How the correction is carried past the samples it was solved on.
@@ -34,6 +33,28 @@ impl crate::names::Named for Extrapolation {
                 "hold the last correction; heading variants continue the heading at its last rate"
             }
         }
+    }
+}
+
+/// The sensor-frame correction `c` of `raw`'s last sample in a correction
+/// that removed the heading `heading_deg` first: `G_R' = R_up(-h) G_R c`
+/// (identity when the IMU was not corrected).
+fn held_after_heading(
+    correction: &Correction,
+    raw: &ImuSeries,
+    vertical: Vertical,
+    heading_deg: f64,
+) -> Quat {
+    let last = raw.orientation.len().checked_sub(1);
+    let corrected = correction.corrected.imu(&raw.name);
+    match (
+        raw.orientation.last(),
+        corrected.and_then(|c| c.orientation.get(last?)),
+    ) {
+        (Some(r), Some(c)) => Quat::new_normalize(
+            ((vertical.heading_rotation(-heading_deg) * r).inverse() * c).into_inner(),
+        ),
+        _ => Quat::identity(),
     }
 }
 
@@ -74,7 +95,7 @@ impl Solution {
         let n = trial.len();
         let t0 = trial.time_s.first().copied().unwrap_or(0.0);
         let last_s = trial.time_s.last().map_or(0.0, |t| t - t0);
-        let heading_kind = correction.variant.info().kind == Kind::Heading;
+        let heading_kind = correction.variant.fits_headings();
         let imus = trial
             .imus
             .iter()
@@ -82,13 +103,20 @@ impl Solution {
                 if heading_kind {
                     if let Some(h) = correction.heading(&raw.name) {
                         if let Some(last) = h.windows.last() {
-                            let [w, x, y, z] = h.correction;
+                            let c = if correction.variant.headings_first() {
+                                // The correction after the heading's removal
+                                // is the windows' C(t), held at its last value.
+                                held_after_heading(correction, raw, h.vertical, last.heading_deg)
+                            } else {
+                                let [w, x, y, z] = h.correction;
+                                Quat::new_normalize(nalgebra::Quaternion::new(w, x, y, z))
+                            };
                             let rate = match how {
                                 Extrapolation::Hold => 0.0,
                                 Extrapolation::HeadingRate => last.rate_deg_s.unwrap_or(0.0),
                             };
                             return ImuExtrapolation::Heading {
-                                c: Quat::new_normalize(nalgebra::Quaternion::new(w, x, y, z)),
+                                c,
                                 heading_deg: last.heading_deg,
                                 rate_deg_s: rate,
                                 centre_s: last.centre_s,

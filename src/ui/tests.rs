@@ -283,7 +283,7 @@ fn compare_scrolls_to_the_baselines_and_saves_one() {
     // Short of rows even in two columns, the status list scrolls to the
     // selected variant and says where it is.
     let small = super::headless::buffer_text(&draw(&app, &Theme::default(), 60, 16));
-    assert!(small.contains("status, variant 7/11"), "{small}");
+    assert!(small.contains("status, variant 7/12"), "{small}");
     assert!(small.contains("> mueller"), "{small}");
     keys(&mut app, "w");
     let out = fx.root().join("trials/corrected/fb.mueller.csv.gz");

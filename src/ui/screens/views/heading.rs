@@ -29,7 +29,7 @@ pub fn shown_variant(app: &Workbench, e: &TrialEntry) -> Option<Variant> {
     ];
     candidates
         .into_iter()
-        .find(|v| v.heading() && e.results.contains_key(v))
+        .find(|v| v.fits_headings() && e.results.contains_key(v))
 }
 
 /// The marker of the `k`-th drifting IMU: its label character (`1`, `2`, ...,
