@@ -63,8 +63,9 @@ pub struct VariantInfo {
     pub centroid: bool,
     /// Estimates the hinge joints' axes and corrects both of their IMUs with them.
     pub hinge: bool,
-    /// Removes each IMU's heading drift, as `drift-heading-centroid`
-    /// estimates it, from the trial before correcting it.
+    /// Removes each IMU's heading drift since its first window, as
+    /// `drift-heading-centroid` estimates it, from the trial before
+    /// correcting it.
     pub headings_first: bool,
     /// One line for `--help` and the help screen.
     pub description: &'static str,
@@ -187,9 +188,9 @@ pub const VARIANTS: &[VariantInfo] = &[
         "hinge-heading",
         Kind::Acm,
         (true, true, true, true),
-        "`hinge` on the trial with each IMU's heading drift removed as \
-         `drift-heading-centroid` estimates it: `G_R' = R_up(-h(t)) G_R C(t)`, \
-         for hinges whose proximal IMU drifts in heading.",
+        "`hinge` on the trial with each IMU's heading drift since its first \
+         window removed as `drift-heading-centroid` estimates it: \
+         `G_R' = R_up(-h(t)) G_R C(t)`, for hinges whose IMUs drift in heading.",
     ),
     row(
         Variant::Auto,

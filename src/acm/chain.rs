@@ -62,11 +62,26 @@ pub fn correct_chain(
     run(trial, model, limits, settings, variant, None, control)
 }
 
+/// `h` with its first window's heading taken from every window's: the drift
+/// since the start. A heading fit reads a misaligned parent as a constant
+/// heading of the child (on the knee test, a thigh 30 deg off about Z as a
+/// calf heading of -16.6 deg in every window); turning the child alone by
+/// it would break the hinge the second pass fits, while the drift that moves
+/// a hinge's axes is the change of heading over the trial.
+fn drift_since_start(mut h: ImuHeading) -> ImuHeading {
+    let first = h.windows.first().map_or(0.0, |w| w.heading_deg);
+    for w in &mut h.windows {
+        w.heading_deg -= first;
+    }
+    h
+}
+
 /// A variant that removes heading drift first (`hinge-heading`): each IMU's
-/// heading drift as `drift-heading-centroid` estimates it is removed from the
-/// trial ([`remove_headings`]), and `hinge` corrects what is left; the result
-/// carries those headings. Both passes solve the same joints over the same
-/// windows, so progress counts each as half of the run.
+/// heading drift since its first window, as `drift-heading-centroid`
+/// estimates it, is removed from the trial ([`remove_headings`]), and `hinge`
+/// corrects what is left; the result carries those headings. Both passes
+/// solve the same joints over the same windows, so progress counts each as
+/// half of the run.
 fn correct_deheaded(
     trial: &Trial,
     model: &Model,
@@ -95,6 +110,7 @@ fn correct_deheaded(
         &pass,
     )?
     .headings;
+    let headings: Vec<ImuHeading> = headings.into_iter().map(drift_since_start).collect();
     let deheaded = remove_headings(trial, &headings);
     let second = |d: usize, n: usize| report(n + d, 2 * n);
     let pass = RunControl {
