@@ -157,6 +157,9 @@ fn malformed_rows_are_located_errors() {
 /// the excursion from them with a dense search for the ellipse's nearest
 /// point.
 fn direct_excursion(l: &SwingTwistLimits, q: &Quat) -> f64 {
+    if l.zyx_box {
+        return direct_zyx_excursion(l, q);
+    }
     let t = l.twist_axis;
     let mut e = Vector3::zeros();
     e[t] = 1.0;
@@ -216,6 +219,62 @@ fn direct_excursion(l: &SwingTwistLimits, q: &Quat) -> f64 {
     swing_e + twist_e
 }
 
+/// The excursion beyond an angle range on the circle: 0 on the arc from `lo`
+/// to `hi`, else the shorter way round to either end.
+fn arc_beyond(a: f64, lo: f64, hi: f64) -> f64 {
+    if (a - lo).rem_euclid(360.0) <= hi - lo {
+        0.0
+    } else {
+        (a - hi).rem_euclid(360.0).min((lo - a).rem_euclid(360.0))
+    }
+}
+
+/// The Z-Y-X box region computed independently: nalgebra's Z-Y-X angles
+/// (`R = Rz(yaw) Ry(pitch) Rx(roll)`), the twist about X as the quaternion's
+/// projection on it; inside the caps |pitch| > 60 deg the roll gives way to
+/// the twist and the yaw's excursion is weighed by `cos(pitch) / cos(60)`.
+fn direct_zyx_excursion(l: &SwingTwistLimits, q: &Quat) -> f64 {
+    let (roll, pitch, yaw) = q.euler_angles();
+    let (roll, pitch, yaw) = (roll.to_degrees(), pitch.to_degrees(), yaw.to_degrees());
+    let v = q.imag();
+    let twist = Quat::from_quaternion(nalgebra::Quaternion::from_parts(
+        q.w,
+        Vector3::new(v.x, 0.0, 0.0),
+    ));
+    let twist = twist.scaled_axis().x.to_degrees();
+    let weight = (pitch.to_radians().cos() / 60f64.to_radians().cos()).min(1.0);
+    let (ylo, yhi) = (
+        l.centre_deg[0] - l.half_deg[0],
+        l.centre_deg[0] + l.half_deg[0],
+    );
+    let (zlo, zhi) = (
+        l.centre_deg[1] - l.half_deg[1],
+        l.centre_deg[1] + l.half_deg[1],
+    );
+    let reading = |roll: f64, pitch: f64, yaw: f64| {
+        let roll = if weight < 1.0 {
+            let shift = (twist - roll + 180.0).rem_euclid(360.0) - 180.0;
+            twist - weight * shift
+        } else {
+            roll
+        };
+        let pitch_e = (pitch - yhi).max(ylo - pitch).max(0.0);
+        arc_beyond(roll, l.twist_deg[0], l.twist_deg[1])
+            + pitch_e
+            + weight * arc_beyond(yaw, zlo, zhi)
+    };
+    let principal = reading(roll, pitch, yaw);
+    if (ylo >= -90.0 && yhi <= 90.0) || principal == 0.0 {
+        return principal;
+    }
+    let other_pitch = if pitch >= 0.0 {
+        180.0 - pitch
+    } else {
+        -180.0 - pitch
+    };
+    principal.min(reading(roll + 180.0, other_pitch, yaw + 180.0))
+}
+
 fn random_quats(seed: u64, n: usize, max_deg: f64) -> Vec<Quat> {
     // A small deterministic generator (no test-only dependency needed).
     let mut s = seed;
@@ -250,6 +309,7 @@ fn test_limits() -> Vec<JointLimits> {
         corner_deg: None,
         twist_deg: [-30.0, 50.0],
         edge_twist_deg: [-5.0, 10.0],
+        zyx_box: false,
     });
     knee.axes = None;
     out.push(knee);
@@ -372,8 +432,10 @@ fn the_knee_test_has_no_singularity_residuals() {
 /// table against those with the Euler table, per joint: the RMS angle between
 /// the corrected joint rotations, and each one's error against the truth.
 /// Away from the Euler singularity (|Y| < 60 deg in every sample of both
-/// results) back, hips, neck and ankles agree within 1-2 deg, shoulders and
-/// elbows within 6.5 and 4.5.
+/// results, at the joint and at every joint above it in the chain, whose
+/// corrections its measured rotations take) every joint agrees within 1 deg:
+/// the shipped table reads every joint but the knee as the Z-Y-X box
+/// (`swing_corner_deg` `zyx`), which is the Euler box's excursion there.
 #[test]
 fn sample_trials_agree_with_the_euler_table_away_from_the_singularity() {
     let model = Model::infant13();
@@ -396,6 +458,9 @@ fn sample_trials_agree_with_the_euler_table_away_from_the_singularity() {
         for variant in [Variant::Basic, Variant::DriftCentroid] {
             let a = run_with_table(&model, &trial, &euler, variant);
             let b = run_with_table(&model, &trial, &st, variant);
+            // Per joint: the RMS and largest difference, and whether a
+            // sample of either result comes within 30 deg of the pole.
+            let mut rows = std::collections::BTreeMap::new();
             for jr in &a.joints {
                 let j = model.joint(&jr.joint).unwrap();
                 let rot = |t: &Trial| -> Vec<Quat> {
@@ -416,49 +481,52 @@ fn sample_trials_agree_with_the_euler_table_away_from_the_singularity() {
                     .chain(&rb)
                     .map(|r| j.table_angles(r)[1].abs())
                     .fold(0.0, f64::max);
-                let near = pitch >= 60.0;
                 let truth_err = |t: &Trial| geodesic_error_deg(&model, &j.name, t, &truth.segments);
+                let errs = (truth_err(&a.corrected), truth_err(&b.corrected));
+                rows.insert(j.name.clone(), (rms, worst, pitch, pitch >= 60.0, errs));
+            }
+            for (joint, &(rms, worst, pitch, _, (ea, eb))) in &rows {
+                // The joints whose corrections this joint's input takes.
+                let mut near_above = None;
+                let mut up = model.joint(joint).unwrap();
+                while let Some(parent) = model.joint_of_distal(&up.proximal) {
+                    if rows.get(&parent.name).is_some_and(|r| r.3) {
+                        near_above = Some(parent.name.clone());
+                    }
+                    up = parent;
+                }
+                let near = pitch >= 60.0 || near_above.is_some();
                 eprintln!(
-                    "{name} {variant} {}: swing-twist vs Euler RMS {rms:5.2}, max {worst:5.2} deg (max |Y| {pitch:5.1}{}); error vs truth Euler {:5.2}, swing-twist {:5.2}",
-                    j.name,
-                    if near { ", near the singularity" } else { "" },
-                    truth_err(&a.corrected),
-                    truth_err(&b.corrected)
+                    "{name} {variant} {joint}: swing-twist vs Euler RMS {rms:5.2}, max {worst:5.2} deg (max |Y| {pitch:5.1}{}); error vs truth Euler {ea:5.2}, swing-twist {eb:5.2}",
+                    match (&near_above, pitch >= 60.0) {
+                        (_, true) => ", near the singularity".to_string(),
+                        (Some(p), false) => format!(", below {p} near the singularity"),
+                        (None, false) => String::new(),
+                    },
                 );
                 if !near {
                     compared += 1;
-                    worst_far.push((format!("{name} {variant} {}", j.name), rms));
+                    worst_far.push((joint.clone(), rms));
                 }
             }
         }
     }
     assert!(compared >= 20, "{compared}");
     let mut by_kind: std::collections::BTreeMap<String, f64> = Default::default();
-    for (what, rms) in &worst_far {
-        let joint = what.rsplit(' ').next().unwrap();
+    for (joint, rms) in &worst_far {
         let kind = model.joint(joint).unwrap().kind.clone();
         let e = by_kind.entry(kind).or_insert(0.0);
         *e = e.max(*rms);
     }
     eprintln!("largest RMS difference away from the singularity, per kind: {by_kind:?}");
-    // The shipped table twists every joint about X, the Z-Y-X sequence's
-    // last axis, so the two tables agree: within 1 deg on the back, 1.5 on
-    // the hips, 2 deg on neck and ankles (measured 0.71, 1.31 (the drifting
-    // trial's l_hip with `basic`; 0.32 before `infant13` declared its prone
-    // axes), 1.88, 1.89); shoulders and elbows, whose Y ranges are wide
-    // (shoulder -40..60) or whose flexion reaches 160 deg, read differently
-    // at large combined movements (measured 6.01 and 4.36, where twisting
-    // them about their long axes, Y and Z, read 13 and 27).
-    for (kind, bound) in [
-        ("back", 1.0),
-        ("hip", 1.5),
-        ("neck", 2.0),
-        ("ankle", 2.0),
-        ("shoulder", 6.5),
-        ("elbow", 4.5),
-    ] {
-        let got = by_kind[kind];
-        assert!(got <= bound, "{kind}: {got} > {bound}");
+    // Measured: at most 1.2e-5 deg (the solver's stopping tolerance). The
+    // ankles are never compared here: every knee above them nears Y = 90
+    // (flexion 75-95 deg), and the knee's row is the rounded box, whose
+    // corrections differ from the Euler box's there (the ankle's own cost is
+    // the Euler one, the unit tests of `zyx_box` show).
+    assert!(by_kind.len() >= 5, "{by_kind:?}");
+    for (kind, got) in &by_kind {
+        assert!(*got <= 1.0, "{kind}: {got} > 1 deg");
     }
 }
 

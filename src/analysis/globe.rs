@@ -478,6 +478,9 @@ pub fn swing_outline(
     per: usize,
 ) -> Vec<[f64; 3]> {
     let per = per.max(4);
+    if st.zyx_box {
+        return zyx_box_outline(st, per);
+    }
     let [a1, a2] = crate::limits::swing_twist::swing_axes(st.twist_axis);
     let [h1, h2] = st.half_deg;
     (0..=per)
@@ -513,6 +516,32 @@ pub fn swing_outline(
             e[st.twist_axis] = 1.0;
             let d = crate::rotation::Quat::from_scaled_axis(rv) * e;
             [d[0], d[1], d[2]]
+        })
+        .collect()
+}
+
+/// The edge of a Z-Y-X box region ([`crate::limits::swing_twist::SwingTwistLimits::zyx_box`]):
+/// the directions `Rz(z) Ry(y) e_x` around its latitude-longitude rectangle
+/// (Y and Z ranges, degrees), `per` points and the first repeated last.
+fn zyx_box_outline(st: &crate::limits::swing_twist::SwingTwistLimits, per: usize) -> Vec<[f64; 3]> {
+    let [c1, c2] = st.centre_deg;
+    let [h1, h2] = st.half_deg;
+    let corners = [
+        [c1 - h1, c2 - h2],
+        [c1 - h1, c2 + h2],
+        [c1 + h1, c2 + h2],
+        [c1 + h1, c2 - h2],
+    ];
+    (0..=per)
+        .map(|k| {
+            // Four sides, each a quarter of the points.
+            let t = 4.0 * (k % per) as f64 / per as f64;
+            let side = (t.floor() as usize).min(3);
+            let f = t - side as f64;
+            let [a, b] = [corners[side], corners[(side + 1) % 4]];
+            let y = (a[0] + (b[0] - a[0]) * f).to_radians();
+            let z = (a[1] + (b[1] - a[1]) * f).to_radians();
+            [y.cos() * z.cos(), y.cos() * z.sin(), -y.sin()]
         })
         .collect()
 }
@@ -764,6 +793,7 @@ mod tests {
             corner_deg: None,
             twist_deg: [-5.0, 5.0],
             edge_twist_deg: [-5.0, 5.0],
+            zyx_box: false,
         };
         let out = swing_outline(&cone, 64);
         assert_eq!(out.len(), 65);
@@ -792,6 +822,28 @@ mod tests {
                 && (-1e-6..=80.0 + 1e-6).contains(&sy)
                 && sz.abs() <= 5.0 + 1e-6;
             assert!(on_edge, "({sy}, {sz})");
+        }
+        // A Z-Y-X box: every point's Z-Y-X angles Y and Z on the rectangle's
+        // edge, the excursion 0 there with the twist inside its range.
+        let shoulder = SwingTwistLimits {
+            twist_axis: 0,
+            centre_deg: [10.0, 0.0],
+            half_deg: [50.0, 70.0],
+            corner_deg: None,
+            zyx_box: true,
+            ..cone
+        };
+        let out = swing_outline(&shoulder, 64);
+        assert_eq!(out.len(), 65);
+        assert_eq!(out[0], out[64]);
+        for d in &out {
+            let y = (-d[2]).asin().to_degrees();
+            let z = d[1].atan2(d[0]).to_degrees();
+            let on_edge = ((y + 40.0).abs() < 1e-9 || (y - 60.0).abs() < 1e-9)
+                || ((z.abs() - 70.0).abs() < 1e-9 && (-40.0..=60.0).contains(&y));
+            assert!(on_edge, "({y}, {z})");
+            let q = crate::rotation::quat_from_euler_zyx_deg([0.0, y, z]);
+            assert!(shoulder.excursion(crate::rotation::wxyz(&q)) < 1e-9);
         }
     }
 }

@@ -52,7 +52,22 @@ pub struct SwingTwistLimits {
     pub twist_deg: [f64; 2],
     /// Twist range `[lo, hi]` on the ellipse's edge and beyond, degrees.
     pub edge_twist_deg: [f64; 2],
+    /// The region read as the table's Z-Y-X box (`swing_corner_deg` `zyx`;
+    /// twist about X only, one twist range): the swing's coordinates are
+    /// the direction of the distal X axis as its Z-Y-X angles Y and Z
+    /// (latitude and longitude), the twist is read as the Z-Y-X angle X,
+    /// i.e. the twist less the twist of `Rz(z) Ry(y)`. Inside the caps |Y| >
+    /// [`ZYX_CAP_DEG`] that twist shift and the Z excursion are weighed down
+    /// by `cos(Y) / cos(cap)` (0 at the poles), so the excursion has no
+    /// singularity; outside them it is the Euler box's excursion exactly.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub zyx_box: bool,
 }
+
+/// The latitude (degrees, the Z-Y-X angle Y) beyond which a
+/// [`SwingTwistLimits::zyx_box`] region gives way to a reading without the
+/// Euler singularity.
+pub const ZYX_CAP_DEG: f64 = 60.0;
 
 /// The excursion of one rotation beyond swing-twist limits in its parts,
 /// degrees.
@@ -113,12 +128,20 @@ impl SwingTwistLimits {
             corner_deg: self.corner_deg,
             twist_deg: flip(self.twist_deg),
             edge_twist_deg: flip(self.edge_twist_deg),
+            zyx_box: self.zyx_box,
         }
     }
 
     /// The swing-twist coordinates of a unit quaternion `[w, x, y, z]` (the
     /// rotation in the table's axes).
     pub fn decompose(&self, q: [f64; 4]) -> SwingTwist {
+        if self.zyx_box {
+            let (r, _) = self.zyx_readings(q);
+            return SwingTwist {
+                swing_deg: [r.pitch, r.yaw],
+                twist_deg: r.roll,
+            };
+        }
         let [s1, s2, t] = coordinates(self.twist_axis, q);
         SwingTwist {
             swing_deg: [s1, s2],
@@ -178,6 +201,14 @@ impl SwingTwistLimits {
     /// the table's axes) in its parts, degrees: what the report's per-axis
     /// figures count. `swing_deg + twist_deg` is [`SwingTwistLimits::excursion`].
     pub fn excursion_parts(&self, q: [f64; 4]) -> ExcursionParts {
+        if self.zyx_box {
+            let e = self.zyx_excursion(q);
+            return ExcursionParts {
+                swing_deg: e.pitch + e.yaw,
+                swing_offset_deg: e.offset,
+                twist_deg: e.roll,
+            };
+        }
         let (swing_deg, twist_deg, swing) = self.parts_of(q);
         let p = [swing[0] - self.centre_deg[0], swing[1] - self.centre_deg[1]];
         let swing_offset_deg = match self.nearest(p) {
@@ -192,8 +223,111 @@ impl SwingTwistLimits {
     }
 
     fn excursion_of<S: Scalar>(&self, q: [S; 4]) -> S {
+        if self.zyx_box {
+            let e = self.zyx_excursion(q);
+            return e.pitch + e.yaw + e.roll;
+        }
         let (swing_e, twist_e, _) = self.parts_of(q);
         swing_e + twist_e
+    }
+
+    /// The Z-Y-X readings of `q` for a [`SwingTwistLimits::zyx_box`] region:
+    /// the principal one, and the other triplet (`x + 180`, `+-180 - y`,
+    /// `z + 180`) where the Y range reaches beyond +-90 deg.
+    fn zyx_readings<S: Scalar>(&self, q: [S; 4]) -> (ZyxReading<S>, Option<ZyxReading<S>>) {
+        let q = if q[0].val() < 0.0 { q.map(|c| -c) } else { q };
+        let [w, x, y, z] = q;
+        let (one, two) = (S::from(1.0), S::from(2.0));
+        let r00 = one - two * (y * y + z * z);
+        let r10 = two * (x * y + w * z);
+        let r20 = two * (x * z - w * y);
+        let r21 = two * (y * z + w * x);
+        let r22 = one - two * (x * x + y * y);
+        let cos_pitch = (r00 * r00 + r10 * r10).sqrt();
+        let deg = S::from(DEG);
+        let pitch = deg * S::atan2(-r20, cos_pitch);
+        let yaw = deg * S::atan2(r10, r00);
+        let roll = deg * S::atan2(r21, r22);
+        let twist = S::from(2.0 * DEG) * S::atan2(x, w);
+        let cap = ZYX_CAP_DEG.to_radians().cos();
+        let weight = if cos_pitch.val() >= cap {
+            None
+        } else {
+            Some(cos_pitch / S::from(cap))
+        };
+        // Inside the caps the roll gives way to the twist: roll = twist -
+        // shift, the shift (the twist of Rz(z) Ry(y)) weighed down.
+        let read = |roll: S, pitch: S, yaw: S| -> ZyxReading<S> {
+            let roll = match weight {
+                None => roll,
+                Some(k) => {
+                    let shift = twist - roll;
+                    let shift = shift + S::from(half_turn_wrap(shift.val()));
+                    twist - k * shift
+                }
+            };
+            ZyxReading {
+                roll,
+                pitch,
+                yaw,
+                weight,
+            }
+        };
+        let principal = read(roll, pitch, yaw);
+        let [c1, _] = self.centre_deg;
+        let [h1, _] = self.half_deg;
+        if c1 - h1 >= -90.0 && c1 + h1 <= 90.0 {
+            return (principal, None);
+        }
+        let other_pitch = if pitch.val() >= 0.0 {
+            S::from(180.0) - pitch
+        } else {
+            S::from(-180.0) - pitch
+        };
+        let turn = |a: S| {
+            let a = a + S::from(180.0);
+            a + S::from(half_turn_wrap(a.val()))
+        };
+        (principal, Some(read(turn(roll), other_pitch, turn(yaw))))
+    }
+
+    /// The excursion of a [`SwingTwistLimits::zyx_box`] region per Z-Y-X
+    /// angle: of the reading with the smaller total.
+    fn zyx_excursion<S: Scalar>(&self, q: [S; 4]) -> ZyxExcursion<S> {
+        let (principal, other) = self.zyx_readings(q);
+        let p = self.zyx_reading_excursion(&principal);
+        let Some(other) = other else {
+            return p;
+        };
+        let total = |e: &ZyxExcursion<S>| (e.roll + e.pitch + e.yaw).val();
+        if total(&p) == 0.0 {
+            return p;
+        }
+        let o = self.zyx_reading_excursion(&other);
+        if total(&o) < total(&p) {
+            o
+        } else {
+            p
+        }
+    }
+
+    fn zyx_reading_excursion<S: Scalar>(&self, r: &ZyxReading<S>) -> ZyxExcursion<S> {
+        let [c1, c2] = self.centre_deg;
+        let [h1, h2] = self.half_deg;
+        let [lo, hi] = self.twist_deg;
+        let (roll, _) = beyond_range(r.roll, lo, hi, true);
+        let (pitch, pitch_off) = beyond_range(r.pitch, c1 - h1, c1 + h1, false);
+        let (yaw, yaw_off) = beyond_range(r.yaw, c2 - h2, c2 + h2, true);
+        let (yaw, yaw_off) = match r.weight {
+            None => (yaw, yaw_off),
+            Some(k) => (k * yaw, k.val() * yaw_off),
+        };
+        ZyxExcursion {
+            roll,
+            pitch,
+            yaw,
+            offset: [pitch_off, yaw_off],
+        }
     }
 
     /// The swing's excursion, the twist's and the swing's coordinates.
@@ -276,6 +410,48 @@ impl SwingTwistLimits {
         // d = n . (swing - centre - near), with near fixed to first order.
         let dc = [self.centre_deg[0] + near[0], self.centre_deg[1] + near[1]];
         S::from(n[0]) * (swing[0] - S::from(dc[0])) + S::from(n[1]) * (swing[1] - S::from(dc[1]))
+    }
+}
+
+/// One Z-Y-X reading of a rotation for a [`SwingTwistLimits::zyx_box`]
+/// region, degrees: `roll` is the twist less its weighed shift inside the
+/// caps, `weight` the caps' weight (`None` outside them).
+struct ZyxReading<S> {
+    roll: S,
+    pitch: S,
+    yaw: S,
+    weight: Option<S>,
+}
+
+/// The excursion of a [`ZyxReading`] per angle (degrees; `yaw` weighed),
+/// and the signed offsets of pitch and yaw beyond their ranges.
+struct ZyxExcursion<S> {
+    roll: S,
+    pitch: S,
+    yaw: S,
+    offset: [f64; 2],
+}
+
+/// The turn (a multiple of 360 degrees) that brings angle `a` into `(-180,
+/// 180]`.
+fn half_turn_wrap(a: f64) -> f64 {
+    -360.0 * ((a - 180.0) / 360.0).ceil()
+}
+
+/// The excursion of `a` beyond `[lo, hi]` (degrees; on the circle the
+/// shorter way round when `circle`) and the signed offset (positive above).
+fn beyond_range<S: Scalar>(a: S, lo: f64, hi: f64, circle: bool) -> (S, f64) {
+    let a = if circle {
+        a + S::from(crate::rotation::arc_turn(a.val(), lo, hi))
+    } else {
+        a
+    };
+    if a.val() > hi {
+        (a - S::from(hi), a.val() - hi)
+    } else if a.val() < lo {
+        (S::from(lo) - a, a.val() - lo)
+    } else {
+        (S::from(0.0), 0.0)
     }
 }
 
@@ -629,7 +805,11 @@ impl SwingTwistRow {
             l.centre_deg[1],
             l.half_deg[0],
             l.half_deg[1],
-            l.corner_deg.map(|r| r.to_string()).unwrap_or_default(),
+            if l.zyx_box {
+                "zyx".to_string()
+            } else {
+                l.corner_deg.map(|r| r.to_string()).unwrap_or_default()
+            },
             l.twist_deg[0],
             l.twist_deg[1],
             edge[0],
@@ -735,7 +915,31 @@ pub(super) fn parse_row(
             )),
         }
     };
-    let corner_deg = optional(7, 0.0, 180.0)?;
+    let zyx_box = rec[7].trim().eq_ignore_ascii_case("zyx");
+    if zyx_box && twist_axis != 0 {
+        return Err(err(
+            line,
+            2,
+            format!(
+                "expected twist_axis X with swing_corner_deg zyx (the Z-Y-X box), found '{}'",
+                &rec[1]
+            ),
+        ));
+    }
+    let corner_deg = if zyx_box {
+        None
+    } else {
+        optional(7, 0.0, 180.0).map_err(|_| {
+            err(
+                line,
+                8,
+                format!(
+                    "expected swing_corner_deg in degrees within 0..180, empty or zyx, found '{}'",
+                    &rec[7]
+                ),
+            )
+        })?
+    };
     if let Some(r) = corner_deg {
         let most = half_deg[0].min(half_deg[1]);
         if r > most {
@@ -756,6 +960,13 @@ pub(super) fn parse_row(
         )
     })?;
     let edge_twist_deg = range(10)?.unwrap_or(twist_deg);
+    if zyx_box && edge_twist_deg != twist_deg {
+        return Err(err(
+            line,
+            11,
+            "expected no edge twist range with swing_corner_deg zyx (the Z-Y-X box has one twist range), found one".into(),
+        ));
+    }
     let c = [
         optional(12, -180.0, 180.0)?,
         optional(13, -180.0, 180.0)?,
@@ -796,6 +1007,7 @@ pub(super) fn parse_row(
             corner_deg,
             twist_deg,
             edge_twist_deg,
+            zyx_box,
         },
         centroid_deg,
         lambda2,
@@ -816,7 +1028,129 @@ mod tests {
             corner_deg: None,
             twist_deg: [-5.0, 5.0],
             edge_twist_deg: [-5.0, 5.0],
+            zyx_box: false,
         }
+    }
+
+    /// A Z-Y-X box region with the ranges `[x, y, z]` (degrees).
+    fn zyx(range: [[f64; 2]; 3]) -> SwingTwistLimits {
+        let [x, y, z] = range;
+        SwingTwistLimits {
+            twist_axis: 0,
+            centre_deg: [0.5 * (y[0] + y[1]), 0.5 * (z[0] + z[1])],
+            half_deg: [0.5 * (y[1] - y[0]), 0.5 * (z[1] - z[0])],
+            corner_deg: None,
+            twist_deg: x,
+            edge_twist_deg: x,
+            zyx_box: true,
+        }
+    }
+
+    /// Table 3-2's boxes of the back, shoulder, hip (Y beyond 90: two
+    /// readings), ankle and a knee.
+    const BOXES: [[[f64; 2]; 3]; 5] = [
+        [[-30.0, 30.0], [-25.0, 30.0], [-35.0, 35.0]],
+        [[-10.0, 100.0], [-40.0, 60.0], [-70.0, 70.0]],
+        [[-50.0, 40.0], [-30.0, 100.0], [-20.0, 50.0]],
+        [[-30.0, 20.0], [-20.0, 45.0], [-10.0, 10.0]],
+        [[-5.0, 5.0], [0.0, 130.0], [-5.0, 5.0]],
+    ];
+
+    fn random_rotation(k: usize) -> Quat {
+        let f = |a: f64| (a * 12.9898 + k as f64 * 78.233).sin() * 43758.5453 % 1.0;
+        quat_axis_angle_deg([f(1.0), f(2.0), f(3.0)], 180.0 * f(4.0).abs())
+    }
+
+    /// Away from the caps the Z-Y-X box region's excursion is the Euler
+    /// box's, `Ex + Ey + Ez` of the Z-Y-X angles as the limits read them.
+    #[test]
+    fn a_zyx_box_is_the_euler_box_outside_the_caps() {
+        let mut compared = 0;
+        for range in BOXES {
+            let lim = zyx(range);
+            for k in 0..4000 {
+                let q = random_rotation(k);
+                let angles =
+                    crate::rotation::read_in_box(crate::rotation::euler_zyx_deg(&q), &range);
+                if crate::rotation::euler_zyx_deg(&q)[1].abs() >= ZYX_CAP_DEG {
+                    continue;
+                }
+                let want: f64 = crate::rotation::box_excursion(angles, &range).iter().sum();
+                let got = lim.excursion(wxyz(&q));
+                assert!(
+                    (got - want).abs() < 1e-9,
+                    "{range:?} {angles:?}: {got} vs {want}"
+                );
+                let parts = lim.excursion_parts(wxyz(&q));
+                assert!((parts.swing_deg + parts.twist_deg - got).abs() < 1e-9);
+                compared += 1;
+            }
+        }
+        assert!(compared > 10_000, "{compared}");
+    }
+
+    /// Inside the caps the excursion has no singularity: near the pole its
+    /// rate stays bounded (pitch 1, the weighed yaw `1 / cos(cap)` plus the
+    /// weight's rate times the yaw's excursion, the roll 1 plus the weight's
+    /// rate times the shift (at most 180) plus the weighed shift's rate:
+    /// under 20 deg per deg), where the Euler box's grows as one over the
+    /// distance from the pole.
+    #[test]
+    fn a_zyx_box_has_no_singularity_at_the_poles() {
+        let lim = zyx(BOXES[1]);
+        let mut worst_rate: f64 = 0.0;
+        let mut euler_worst: f64 = 0.0;
+        let axis =
+            |k: usize| -> [f64; 3] { random_rotation(k).axis().unwrap().into_inner().into() };
+        for k in 0..400 {
+            // 0.3 deg from the pole Y = 90, then a step of 0.01 deg.
+            let near =
+                quat_axis_angle_deg([0.0, 1.0, 0.0], 90.0) * quat_axis_angle_deg(axis(k), 0.3);
+            let (a, b) = (near, near * quat_axis_angle_deg(axis(k + 7), 0.01));
+            let rate = (lim.excursion(wxyz(&a)) - lim.excursion(wxyz(&b))).abs() / 0.01;
+            worst_rate = worst_rate.max(rate);
+            let e = |q: &Quat| -> f64 {
+                let ang =
+                    crate::rotation::read_in_box(crate::rotation::euler_zyx_deg(q), &BOXES[1]);
+                crate::rotation::box_excursion(ang, &BOXES[1]).iter().sum()
+            };
+            euler_worst = euler_worst.max((e(&a) - e(&b)).abs() / 0.01);
+        }
+        eprintln!("rate near the pole: {worst_rate:.2} (Euler box {euler_worst:.1}) deg per deg");
+        assert!(worst_rate <= 20.0, "{worst_rate}");
+        assert!(euler_worst > 100.0, "{euler_worst}");
+    }
+
+    /// The gradient of a Z-Y-X box region against central differences,
+    /// inside and outside the caps.
+    #[test]
+    fn a_zyx_box_gradient_is_the_finite_difference() {
+        let h = 1e-6;
+        let mut checked = 0;
+        for range in BOXES {
+            let lim = zyx(range);
+            for k in 0..300 {
+                let q = random_rotation(k + 99);
+                let (e, g) = lim.excursion_grad(wxyz(&q));
+                for (axis, gk) in g.iter().enumerate() {
+                    let mut v = Vector3::zeros();
+                    v[axis] = h;
+                    let up = lim.excursion(wxyz(&(q * Quat::from_scaled_axis(v))));
+                    let down = lim.excursion(wxyz(&(q * Quat::from_scaled_axis(-v))));
+                    // Skip a kink within the step.
+                    if ((up - e) - (e - down)).abs() > 1e-4 * h.max((up - e).abs()) + 1e-9 {
+                        continue;
+                    }
+                    let fd = (up - down) / (2.0 * h);
+                    assert!(
+                        (fd - gk).abs() < 1e-4 * (1.0 + gk.abs()),
+                        "{range:?} {k} {axis}: {gk} vs {fd}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 2000, "{checked}");
     }
 
     /// The decomposition against one built from nalgebra: twist the rotation
@@ -902,6 +1236,7 @@ mod tests {
             corner_deg: Some(0.0),
             twist_deg: [0.0, 160.0],
             edge_twist_deg: [0.0, 160.0],
+            zyx_box: false,
         };
         let e = |deg: f64| elbow.excursion(wxyz(&quat_axis_angle_deg([1.0, 0.0, 0.0], deg)));
         assert!((e(170.0) - 10.0).abs() < 1e-9);
@@ -960,6 +1295,7 @@ mod tests {
             corner_deg: None,
             twist_deg: [-10.0, 10.0],
             edge_twist_deg: [-20.0, 0.0],
+            zyx_box: false,
         };
         for dir in [[1.0, 0.0, 0.0], [0.6, -0.8, 0.0], [-1.0, 1.0, 0.0]] {
             let q = quat_axis_angle_deg(dir, 50.0);
@@ -986,6 +1322,7 @@ mod tests {
                 corner_deg: Some(10.0),
                 twist_deg: [-40.0, 60.0],
                 edge_twist_deg: [-10.0, 20.0],
+                zyx_box: false,
             },
             SwingTwistLimits {
                 twist_axis: 2,
@@ -994,6 +1331,7 @@ mod tests {
                 corner_deg: None,
                 twist_deg: [-10.0, 10.0],
                 edge_twist_deg: [-10.0, 10.0],
+                zyx_box: false,
             },
         ];
         let mut checked = 0;
