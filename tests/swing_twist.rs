@@ -483,14 +483,14 @@ fn sample_trials_agree_with_the_euler_table_away_from_the_singularity() {
                     .fold(0.0, f64::max);
                 let truth_err = |t: &Trial| geodesic_error_deg(&model, &j.name, t, &truth.segments);
                 let errs = (truth_err(&a.corrected), truth_err(&b.corrected));
-                rows.insert(j.name.clone(), (rms, worst, pitch, pitch >= 60.0, errs));
+                rows.insert(j.name.clone(), (rms, worst, pitch, errs));
             }
-            for (joint, &(rms, worst, pitch, _, (ea, eb))) in &rows {
+            for (joint, &(rms, worst, pitch, (ea, eb))) in &rows {
                 // The joints whose corrections this joint's input takes.
                 let mut near_above = None;
                 let mut up = model.joint(joint).unwrap();
                 while let Some(parent) = model.joint_of_distal(&up.proximal) {
-                    if rows.get(&parent.name).is_some_and(|r| r.3) {
+                    if rows.get(&parent.name).is_some_and(|r| r.2 >= 60.0) {
                         near_above = Some(parent.name.clone());
                     }
                     up = parent;

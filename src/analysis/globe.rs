@@ -524,14 +524,8 @@ pub fn swing_outline(
 /// the directions `Rz(z) Ry(y) e_x` around its latitude-longitude rectangle
 /// (Y and Z ranges, degrees), `per` points and the first repeated last.
 fn zyx_box_outline(st: &crate::limits::swing_twist::SwingTwistLimits, per: usize) -> Vec<[f64; 3]> {
-    let [c1, c2] = st.centre_deg;
-    let [h1, h2] = st.half_deg;
-    let corners = [
-        [c1 - h1, c2 - h2],
-        [c1 - h1, c2 + h2],
-        [c1 + h1, c2 + h2],
-        [c1 + h1, c2 - h2],
-    ];
+    let [_, [y0, y1], [z0, z1]] = st.zyx_ranges();
+    let corners = [[y0, z0], [y0, z1], [y1, z1], [y1, z0]];
     (0..=per)
         .map(|k| {
             // Four sides, each a quarter of the points.
@@ -541,7 +535,7 @@ fn zyx_box_outline(st: &crate::limits::swing_twist::SwingTwistLimits, per: usize
             let [a, b] = [corners[side], corners[(side + 1) % 4]];
             let y = (a[0] + (b[0] - a[0]) * f).to_radians();
             let z = (a[1] + (b[1] - a[1]) * f).to_radians();
-            [y.cos() * z.cos(), y.cos() * z.sin(), -y.sin()]
+            direction_sc([(0.0, 1.0), y.sin_cos(), z.sin_cos()], 0)
         })
         .collect()
 }

@@ -132,6 +132,15 @@ impl SwingTwistLimits {
         }
     }
 
+    /// The Z-Y-X box `[x, y, z]` (degrees) a [`SwingTwistLimits::zyx_box`]
+    /// region reads: the twist range on X, the region's extent on `swing_1`
+    /// (Y) and `swing_2` (Z).
+    pub fn zyx_ranges(&self) -> [[f64; 2]; 3] {
+        let [c1, c2] = self.centre_deg;
+        let [h1, h2] = self.half_deg;
+        [self.twist_deg, [c1 - h1, c1 + h1], [c2 - h2, c2 + h2]]
+    }
+
     /// The swing-twist coordinates of a unit quaternion `[w, x, y, z]` (the
     /// rotation in the table's axes).
     pub fn decompose(&self, q: [f64; 4]) -> SwingTwist {
@@ -248,19 +257,21 @@ impl SwingTwistLimits {
         let pitch = deg * S::atan2(-r20, cos_pitch);
         let yaw = deg * S::atan2(r10, r00);
         let roll = deg * S::atan2(r21, r22);
-        let twist = S::from(2.0 * DEG) * S::atan2(x, w);
         let cap = ZYX_CAP_DEG.to_radians().cos();
-        let weight = if cos_pitch.val() >= cap {
-            None
-        } else {
-            Some(cos_pitch / S::from(cap))
-        };
         // Inside the caps the roll gives way to the twist: roll = twist -
-        // shift, the shift (the twist of Rz(z) Ry(y)) weighed down.
+        // shift, the shift (the twist of Rz(z) Ry(y)) weighed down. Outside
+        // them the twist is not needed.
+        let inside_cap = (cos_pitch.val() < cap).then(|| {
+            (
+                cos_pitch / S::from(cap),
+                S::from(2.0 * DEG) * S::atan2(x, w),
+            )
+        });
+        let weight = inside_cap.map(|(k, _)| k);
         let read = |roll: S, pitch: S, yaw: S| -> ZyxReading<S> {
-            let roll = match weight {
+            let roll = match inside_cap {
                 None => roll,
-                Some(k) => {
+                Some((k, twist)) => {
                     let shift = twist - roll;
                     let shift = shift + S::from(half_turn_wrap(shift.val()));
                     twist - k * shift
@@ -274,9 +285,7 @@ impl SwingTwistLimits {
             }
         };
         let principal = read(roll, pitch, yaw);
-        let [c1, _] = self.centre_deg;
-        let [h1, _] = self.half_deg;
-        if c1 - h1 >= -90.0 && c1 + h1 <= 90.0 {
+        if !crate::rotation::y_beyond_90(&self.zyx_ranges()) {
             return (principal, None);
         }
         let other_pitch = if pitch.val() >= 0.0 {
@@ -312,12 +321,10 @@ impl SwingTwistLimits {
     }
 
     fn zyx_reading_excursion<S: Scalar>(&self, r: &ZyxReading<S>) -> ZyxExcursion<S> {
-        let [c1, c2] = self.centre_deg;
-        let [h1, h2] = self.half_deg;
-        let [lo, hi] = self.twist_deg;
-        let (roll, _) = beyond_range(r.roll, lo, hi, true);
-        let (pitch, pitch_off) = beyond_range(r.pitch, c1 - h1, c1 + h1, false);
-        let (yaw, yaw_off) = beyond_range(r.yaw, c2 - h2, c2 + h2, true);
+        let [x, y, z] = self.zyx_ranges().map(|r| r.map(S::from));
+        let (roll, _) = beyond_range(r.roll, x[0], x[1], true);
+        let (pitch, pitch_off) = beyond_range(r.pitch, y[0], y[1], false);
+        let (yaw, yaw_off) = beyond_range(r.yaw, z[0], z[1], true);
         let (yaw, yaw_off) = match r.weight {
             None => (yaw, yaw_off),
             Some(k) => (k * yaw, k.val() * yaw_off),
@@ -351,14 +358,7 @@ impl SwingTwistLimits {
         let hi = S::from(h0) + S::from(h1 - h0) * f;
         // The twist is an angle on the circle: its excursion is the shorter
         // way round to the range, as the Euler box reads X and Z.
-        let tw = tw + S::from(crate::rotation::arc_turn(tw.val(), lo.val(), hi.val()));
-        let twist_e = if tw.val() > hi.val() {
-            tw - hi
-        } else if tw.val() < lo.val() {
-            lo - tw
-        } else {
-            S::from(0.0)
-        };
+        let (twist_e, _) = beyond_range(tw, lo, hi, true);
         (swing_e, twist_e, [s1.val(), s2.val()])
     }
 
@@ -439,19 +439,19 @@ fn half_turn_wrap(a: f64) -> f64 {
 }
 
 /// The excursion of `a` beyond `[lo, hi]` (degrees; on the circle the
-/// shorter way round when `circle`) and the signed offset (positive above).
-fn beyond_range<S: Scalar>(a: S, lo: f64, hi: f64, circle: bool) -> (S, f64) {
+/// shorter way round when `circle`, as the Euler box reads X and Z) and the
+/// signed offset (positive above). The bounds may carry derivatives (a
+/// twist range that moves with the swing).
+fn beyond_range<S: Scalar>(a: S, lo: S, hi: S, circle: bool) -> (S, f64) {
     let a = if circle {
-        a + S::from(crate::rotation::arc_turn(a.val(), lo, hi))
+        a + S::from(crate::rotation::arc_turn(a.val(), lo.val(), hi.val()))
     } else {
         a
     };
-    if a.val() > hi {
-        (a - S::from(hi), a.val() - hi)
-    } else if a.val() < lo {
-        (S::from(lo) - a, a.val() - lo)
-    } else {
-        (S::from(0.0), 0.0)
+    match crate::rotation::beyond_line_slope(a.val(), lo.val(), hi.val()) {
+        (_, 0.0) => (S::from(0.0), 0.0),
+        (e, slope) if slope > 0.0 => (a - hi, e),
+        (e, _) => (lo - a, -e),
     }
 }
 
