@@ -199,10 +199,10 @@ pub const VARIANTS: &[VariantInfo] = &[
         "auto",
         Kind::Auto,
         (true, false, false, false),
-        "Per joint in chain order, the one of drift-heading-centroid, \
-         drift-heading, drift-centroid, drift and none that keeps the joint \
-         inside its limits with the steadiest correction (docs/method.md section 19); \
-         the choice and its figures are in the sidecar.",
+        "Per joint in chain order, the joint rotation of the one of \
+         hinge-heading, hinge, drift-heading-centroid, drift-heading, \
+         drift-centroid, drift and none that keeps the joint inside its limits \
+         (docs/method.md section 19); the choice and its figures are in the sidecar.",
     ),
     row(
         Variant::None,

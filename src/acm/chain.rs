@@ -59,6 +59,10 @@ pub fn correct_chain(
     if variant.headings_first() {
         return correct_deheaded(trial, model, limits, settings, variant, control);
     }
+    if variant == Variant::Auto {
+        let none = Default::default();
+        return super::auto_run::correct_auto(trial, model, limits, settings, &none, control);
+    }
     run(trial, model, limits, settings, variant, None, control)
 }
 
@@ -100,7 +104,7 @@ fn correct_deheaded(
         cancel: control.cancel,
         progress: Some(&first),
     };
-    let headings = run(
+    let first_pass = run(
         trial,
         model,
         limits,
@@ -108,15 +112,39 @@ fn correct_deheaded(
         Variant::DriftHeadingCentroid,
         None,
         &pass,
-    )?
-    .headings;
-    let headings: Vec<ImuHeading> = headings.into_iter().map(drift_since_start).collect();
-    let deheaded = remove_headings(trial, &headings);
+    )?;
     let second = |d: usize, n: usize| report(n + d, 2 * n);
     let pass = RunControl {
         cancel: control.cancel,
         progress: Some(&second),
     };
+    correct_deheaded_from(
+        trial,
+        model,
+        limits,
+        settings,
+        (variant, &first_pass),
+        &pass,
+    )
+}
+
+/// The second pass of [`correct_deheaded`]: `hinge` on the trial with the
+/// heading drift since the start that `first_pass` (a
+/// `drift-heading-centroid` correction of the same trial, model, limits and
+/// settings) fitted removed; the result is `variant`'s and carries those
+/// headings.
+pub(crate) fn correct_deheaded_from(
+    trial: &Trial,
+    model: &Model,
+    limits: &LimitTable,
+    settings: &Settings,
+    (variant, first_pass): (Variant, &Correction),
+    control: &RunControl,
+) -> Result<Correction, Cancelled> {
+    let headings: Vec<ImuHeading> = (first_pass.headings.iter().cloned())
+        .map(drift_since_start)
+        .collect();
+    let deheaded = remove_headings(trial, &headings);
     let mut c = run(
         &deheaded,
         model,
@@ -124,7 +152,7 @@ fn correct_deheaded(
         settings,
         Variant::Hinge,
         None,
-        &pass,
+        control,
     )?;
     c.variant = variant;
     c.headings = headings;
@@ -163,7 +191,8 @@ pub fn uncorrected(
 /// for the rest (after a limit edit, say). For the heading variants the joint
 /// above each named one is redone too, with everything below it: its IMU's fit
 /// looks ahead at the named joint's limits ([`super::lookahead`]); a variant
-/// that removes heading drift first is redone whole. `previous` must come
+/// that removes heading drift first is redone whole, and so is `auto` (its
+/// candidates' runs, keeping the user's overrides). `previous` must come
 /// from the same trial, model and variant, one of the chain's kinds.
 pub fn recorrect_chain(
     trial: &Trial,
@@ -178,6 +207,12 @@ pub fn recorrect_chain(
         // The headings are fitted with every joint's limits: all is redone.
         return correct_chain(trial, model, limits, settings, previous.variant, control);
     }
+    if previous.variant == Variant::Auto {
+        // Its candidates include the heading-first one: all is redone,
+        // keeping the user's overrides.
+        let forced = super::auto_run::overrides(previous);
+        return super::auto_run::correct_auto(trial, model, limits, settings, &forced, control);
+    }
     let mut redo = BTreeSet::new();
     for (k, j) in model.joints.iter().enumerate() {
         if joints.contains(&j.name.as_str()) {
@@ -187,7 +222,7 @@ pub fn recorrect_chain(
                 .joints
                 .iter()
                 .position(|p| p.distal == j.proximal)
-                .filter(|_| previous.variant.heading() || previous.variant == Variant::Auto)
+                .filter(|_| previous.variant.heading())
                 .unwrap_or(k);
             redo.insert(parent);
             redo.extend(model.descendants(parent));
@@ -229,25 +264,14 @@ fn run(
     reuse: Option<(&Correction, &BTreeSet<usize>)>,
     control: &RunControl,
 ) -> Result<Correction, Cancelled> {
-    let candidates = match variant {
-        Variant::Auto => super::auto::CANDIDATES,
-        _ => std::slice::from_ref(&variant),
-    };
     let windows = if variant.windowed() {
         layout(&trial.time_s, settings.window_s, settings.hop_s)
     } else {
         whole_trial(&trial.time_s)
     };
-    // One plan per candidate: its limits (with or without the centroid
-    // term) and, for `hinge`, its axes. The joints are the same in each.
-    let mut plans: Vec<(Variant, Vec<(usize, JointLimits)>)> = Vec::new();
-    let mut skipped = Vec::new();
-    for &v in candidates {
-        let (todo, s) = plan_joints(trial, model, limits, v);
-        plans.push((v, todo));
-        skipped = s;
-    }
-    let todo = plans[0].1.clone();
+    // The joints with their limits (with or without the centroid term)
+    // and, for `hinge`, their axes.
+    let (todo, skipped) = plan_joints(trial, model, limits, variant);
     let mut hinges = hinge_fits(trial, model, &todo, variant, &windows);
     let solve_count = todo
         .iter()
@@ -255,7 +279,7 @@ fn run(
         .count();
     let progress = Progress {
         done: AtomicUsize::new(0),
-        total: solve_count * windows.len() * candidates.len(),
+        total: solve_count * windows.len(),
         control,
     };
     let mut corrected = trial.clone();
@@ -278,52 +302,27 @@ fn run(
                 (&windows, settings.lambda1),
             );
         }
-        let passes: Vec<Pass> = plans
-            .iter()
-            .map(|(v, todo)| Pass {
-                trial,
-                model,
-                settings,
-                variant: *v,
-                reuse,
-                windows: &windows,
-                todo,
-                hinges: &hinges,
-                corrected: &corrected,
-                results: &results,
-                progress: &progress,
-            })
-            .collect();
-        let jobs: Vec<(usize, usize)> = level
-            .iter()
-            .flat_map(|&i| (0..passes.len()).map(move |c| (i, c)))
-            .collect();
-        let mut solved: Vec<Solved> = jobs
+        let pass = Pass {
+            trial,
+            model,
+            settings,
+            variant,
+            reuse,
+            windows: &windows,
+            todo: &todo,
+            hinges: &hinges,
+            corrected: &corrected,
+            results: &results,
+            progress: &progress,
+        };
+        let solved: Vec<Solved> = level
             .par_iter()
-            .map(|&(i, c)| {
-                let (k, lim) = &passes[c].todo[i];
-                passes[c].solve_joint(*k, lim)
+            .map(|&i| {
+                let (k, lim) = &pass.todo[i];
+                pass.solve_joint(*k, lim)
             })
             .collect::<Result<_, Cancelled>>()?;
-        drop(passes);
-        let mut chosen: Vec<Solved> = Vec::with_capacity(level.len());
-        while !solved.is_empty() {
-            let rest = solved.split_off(candidates.len());
-            let mine = std::mem::replace(&mut solved, rest);
-            chosen.push(if candidates.len() == 1 || mine[0].1.auto.is_some() {
-                // A single variant, or a joint an earlier run chose for.
-                mine.into_iter().next().expect("one candidate")
-            } else {
-                let forced = reuse
-                    .and_then(|(prev, _)| prev.joint(&model.joints[mine[0].0].name))
-                    .and_then(|r| r.auto.as_ref())
-                    .filter(|a| a.overridden.is_some())
-                    .map(|a| a.chosen);
-                let lists = (candidates, forced);
-                choose(trial, model, limits, &corrected, lists, mine)
-            });
-        }
-        for (k, result, applied, heading) in chosen {
+        for (k, result, applied, heading) in solved {
             if let Some(h) = heading {
                 headings.insert(k, h);
             }
@@ -345,46 +344,6 @@ fn run(
         skipped,
         ik: None,
     })
-}
-
-/// Picks one of a joint's candidate solutions (`auto`), or the one the user
-/// forced, recording the choice in its result.
-fn choose(
-    trial: &Trial,
-    model: &Model,
-    limits: &LimitTable,
-    corrected: &Trial,
-    (variants, forced): (&[Variant], Option<Variant>),
-    mine: Vec<Solved>,
-) -> Solved {
-    let k = mine[0].0;
-    let joint = &model.joints[k];
-    let raw = trial.imu(&joint.distal).expect("present");
-    let candidates: Vec<super::auto::Candidate> = mine
-        .iter()
-        .zip(variants)
-        .map(
-            |((_, r, applied, heading), &variant)| super::auto::Candidate {
-                variant,
-                distal: applied.orientations(&raw.orientation),
-                windows: &r.windows,
-                heading: heading.as_ref(),
-            },
-        )
-        .collect();
-    let view = super::auto::JointCandidates {
-        joint,
-        limits: limits.joint_limits(&joint.name, &joint.kind, true),
-        parent: &corrected.imu(&joint.proximal).expect("present").orientation,
-        raw: &raw.orientation,
-        candidates,
-    };
-    let choice = super::auto::choose(&view, forced);
-    drop(view);
-    let pick = choice.chosen_index;
-    let (k, mut result, applied, heading) = mine.into_iter().nth(pick).expect("a candidate");
-    result.auto = Some(choice.record);
-    (k, result, applied, heading)
 }
 
 /// The joints to correct, each with its limits (by index in the model's
@@ -477,13 +436,6 @@ impl Pass<'_> {
             axis_from: families.as_ref().and_then(|f| f.from_child.clone()),
             auto: None,
         };
-        if self.variant == Variant::None {
-            // `auto`'s fallback: the joint left as measured.
-            let windows = self.identity_windows(joint, lim);
-            let raw = self.trial.imu(&joint.distal).expect("present");
-            let applied = Applied::Kept(raw.orientation.clone(), raw.gyro.clone());
-            return Ok((k, result(windows, None), applied, None));
-        }
         if self.variant.heading() {
             let (windows, applied, heading) = self.solve_heading_joint(joint, lim)?;
             return Ok((k, result(windows, None), applied, Some(heading)));
@@ -539,35 +491,6 @@ impl Pass<'_> {
         Ok((k, result(sol.windows, None), applied, None))
     }
 
-    /// The windows of a joint left uncorrected: C = identity, at its cost.
-    fn identity_windows(&self, joint: &Joint, lim: &JointLimits) -> Vec<WindowSolution> {
-        let parent = &self.corrected.imu(&joint.proximal).expect("present");
-        let child = &self.trial.imu(&joint.distal).expect("present");
-        self.windows
-            .iter()
-            .map(|w| {
-                let measured: Vec<Quat> = (w.first..w.end)
-                    .map(|i| parent.orientation[i].inverse() * child.orientation[i])
-                    .collect();
-                let cost =
-                    WindowCost::new(&measured, lim, self.settings.lambda1).eval(&Quat::identity());
-                self.progress.window_done();
-                WindowSolution {
-                    start_s: w.start_s,
-                    end_s: w.end_s,
-                    centre_s: w.centre_s,
-                    samples: w.len(),
-                    correction: [1.0, 0.0, 0.0, 0.0],
-                    angle_deg: 0.0,
-                    cost,
-                    cost_uncorrected: cost,
-                    evaluations: 1,
-                }
-            })
-            .collect()
-    }
-
-    /// An earlier run's result for joint `k`, when the run re-solves other joints only.
     /// The limits of the two-axis hinge below whose axis gave `families`.
     fn child_term(&self, families: &Families) -> Option<ChildTerm> {
         let c = families.two_axis_child?;
@@ -581,6 +504,7 @@ impl Pass<'_> {
         )
     }
 
+    /// An earlier run's result for joint `k`, when the run re-solves other joints only.
     fn kept(&self, k: usize) -> Option<Solved> {
         let (prev, redo) = self.reuse?;
         if redo.contains(&k) {
@@ -1043,20 +967,6 @@ enum Applied {
     /// Corrected orientations and gyroscope readings to take as they are (a
     /// heading fit, or an earlier run's kept result).
     Kept(Vec<Quat>, Gyros),
-}
-
-impl Applied {
-    /// The distal IMU's corrected orientations, from its measured ones.
-    fn orientations(&self, raw: &[Quat]) -> Vec<Quat> {
-        match self {
-            Applied::Series(series, _) => raw
-                .iter()
-                .zip(series)
-                .map(|(q, c)| Quat::new_normalize((*q * c).into_inner()))
-                .collect(),
-            Applied::Kept(orientation, _) => orientation.clone(),
-        }
-    }
 }
 
 /// What a per-sample correction `C(t)` does to the distal IMU's gyros.

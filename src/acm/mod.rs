@@ -9,6 +9,7 @@
 //! instead ([`heading`]), looking ahead at the joints below it ([`lookahead`]).
 
 pub mod auto;
+pub mod auto_run;
 pub mod chain;
 pub mod cost;
 pub mod heading;

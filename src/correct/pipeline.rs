@@ -261,6 +261,19 @@ pub fn correct_many(
             cancel: control.cancel,
             progress: Some(&report),
         };
+        if variant == Variant::Auto {
+            // Composed from its candidates when they were corrected first.
+            let forced = recorrect_from.map_or_else(Default::default, |r| {
+                crate::acm::auto_run::overrides(r.previous[k])
+            });
+            let made: Vec<&Correction> = out.iter().collect();
+            let parts = (setup.model, setup.limits, setup.settings);
+            if let Some(c) = crate::acm::auto_run::compose_from(trial, parts, &made, &forced) {
+                report(1, 1);
+                out.push(c);
+                continue;
+            }
+        }
         let c = match recorrect_from {
             Some(r) => recorrect(
                 trial,
@@ -283,11 +296,13 @@ pub fn correct_many(
 /// joints below it solved again. The override is recorded in the joint's
 /// `auto` record (and so in the sidecar) and kept by later re-corrections.
 /// A joint `auto` did not choose for (or a variant that is not one of its
-/// candidates) leaves `previous` as it was.
+/// candidates) leaves `previous` as it was. When `others` holds every
+/// candidate's correction of the trial with the same setup, `auto` is
+/// composed from them without solving anything.
 pub fn override_auto(
     trial: &Trial,
     setup: Setup,
-    previous: &Correction,
+    (previous, others): (&Correction, &[&Correction]),
     joint: &str,
     choice: Option<Variant>,
     control: &RunControl,
@@ -311,6 +326,11 @@ pub fn override_auto(
             a.chosen = own;
             a.overridden = None;
         }
+    }
+    let forced = crate::acm::auto_run::overrides(&edited);
+    let parts = (setup.model, setup.limits, setup.settings);
+    if let Some(c) = crate::acm::auto_run::compose_from(trial, parts, others, &forced) {
+        return Ok(c);
     }
     recorrect(
         trial,

@@ -223,17 +223,24 @@ pub fn run_job(job: &RunJob, cancel: &AtomicBool, progress: &(dyn Fn(u8) + Sync)
             None => None,
         };
         let out: Vec<Arc<Correction>> = match (&job.auto_override, &job.recorrect) {
-            (Some((joint, choice)), Some((previous, _))) => previous
-                .iter()
-                .map(|c| match c.variant {
-                    Variant::Auto => {
-                        pipeline::override_auto(&l.trial, setup, c, joint, *choice, &control)
-                            .map(Arc::new)
-                    }
-                    _ => Ok(c.clone()),
-                })
-                .collect::<Result<_, _>>()
-                .map_err(|e| e.to_string())?,
+            (Some((joint, choice)), Some((all, _))) => {
+                let others: Vec<&Correction> = all.iter().map(|c| &**c).collect();
+                all.iter()
+                    .map(|c| match c.variant {
+                        Variant::Auto => pipeline::override_auto(
+                            &l.trial,
+                            setup,
+                            (c, &others),
+                            joint,
+                            *choice,
+                            &control,
+                        )
+                        .map(Arc::new),
+                        _ => Ok(c.clone()),
+                    })
+                    .collect::<Result<_, _>>()
+                    .map_err(|e| e.to_string())?
+            }
             _ => pipeline::correct_many(&l.trial, setup, &Variant::ALL, recorrect, &control)
                 .map_err(|e| e.to_string())?
                 .into_iter()
