@@ -200,7 +200,7 @@ pub const VARIANTS: &[VariantInfo] = &[
         Kind::Auto,
         (true, false, false, false),
         "Per joint in chain order, the joint rotation of the one of \
-         hinge-heading, hinge, drift-heading-centroid, drift-heading, \
+         hinge-heading, drift-heading-centroid, drift-heading, \
          drift-centroid, drift and none that keeps the joint inside its limits \
          (docs/method.md section 19); the choice and its figures are in the sidecar.",
     ),

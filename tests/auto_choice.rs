@@ -309,7 +309,7 @@ fn assert_targets(f: &Figures, hindsight: bool) {
 }
 
 /// The must-show's own set: 24 held-out trials of 120 s (each disturbance,
-/// both motions), against all six single variants (measured 3.26 against
+/// both motions), against all six single variants (measured 3.25 against
 /// `hinge-heading`'s 3.50, mean worst 6.80 against its 7.10).
 #[test]
 fn auto_beats_every_single_variant_on_held_out_trials() {
@@ -321,7 +321,7 @@ fn auto_beats_every_single_variant_on_held_out_trials() {
 }
 
 /// The full must-show, hindsight included (`benches/auto_eval.sh`): not met
-/// yet (auto 3.26, hindsight 2.91 deg on the median: 0.35 above).
+/// yet (auto 3.25, hindsight 2.91 deg on the median: 0.34 above).
 #[test]
 #[ignore = "minutes, and the hindsight target is open: run by benches/auto_eval.sh"]
 fn auto_on_24_held_out_trials() {

@@ -9,7 +9,8 @@
 //! `G_R_prox'(t) (G_R_prox,v(t))^-1 G_R_dist,v(t)`, the proximal IMU as
 //! `auto` corrected it times the joint rotation of candidate `v`'s run. So a
 //! `hinge` knee, whose thigh the hinge run turned onto the knee's axis,
-//! keeps its hinge angles under a hip `drift-centroid` won.
+//! keeps its hinge angles under a hip `drift-centroid` won (`hinge-heading`
+//! is the hinge candidate).
 
 use super::auto::{Candidate, JointCandidates, CANDIDATES};
 use super::chain::{correct_chain, correct_deheaded_from};
