@@ -585,7 +585,10 @@ const REFINED_MINIMA: usize = 3;
 /// dip narrower than the coarse grid, away from those minima (the descent
 /// that follows then starts in another basin). Grids that are not a whole
 /// number of coarse steps are scanned whole.
-fn refined_grid_minimum(eval: &mut impl FnMut(f64) -> f64, step: f64) -> Option<(f64, f64)> {
+pub(crate) fn refined_grid_minimum(
+    eval: &mut impl FnMut(f64) -> f64,
+    step: f64,
+) -> Option<(f64, f64)> {
     let n = grid_points(step);
     if !n.is_multiple_of(REFINE_BY) || n < 3 * REFINE_BY {
         return grid_minimum(eval, step);

@@ -685,10 +685,10 @@ pub struct AxisSolution {
     pub evaluations: usize,
 }
 
-/// Minimises `cost(C(phi), phi)` (`phi` in degrees) over the family: a scan
-/// of `phi` over the whole turn at 2 deg steps, then a golden-section search
-/// in the steps either side of the best (the first best on ties, so the
-/// result is deterministic).
+/// Minimises `cost(C(phi), phi)` (`phi` in degrees) over the family: the
+/// lowest point of the 2-deg grid over the whole turn ([`minimise_turn`]),
+/// then a golden-section search in the steps either side of it (the first
+/// best on ties, so the result is deterministic).
 pub fn minimise_about_axis(cost: &dyn Fn(&Quat, f64) -> f64, family: &AxisFamily) -> AxisSolution {
     let (phi, v, evaluations) = minimise_turn(&|phi: f64| cost(&family.at(phi), wrap180(phi)));
     AxisSolution {
@@ -700,19 +700,24 @@ pub fn minimise_about_axis(cost: &dyn Fn(&Quat, f64) -> f64, family: &AxisFamily
 }
 
 /// The turn `phi` (degrees, in (-180, 180]) minimising `f` over the whole
-/// circle: a scan every [`SCAN_STEP_DEG`], then a golden-section search
-/// around the scan's lowest point. Returns `(phi, f(phi), evaluations)`.
+/// circle: the lowest point of the grid every [`SCAN_STEP_DEG`], looked for
+/// coarse to fine as the heading fit's scan is (every 3rd point, then the
+/// points around the coarse grid's three lowest local minima: 72
+/// evaluations where the whole grid takes 180), `phi = 0` kept on a tie;
+/// then a golden-section search around it. Returns `(phi, f(phi),
+/// evaluations)`.
 pub fn minimise_turn(f: &dyn Fn(f64) -> f64) -> (f64, f64, usize) {
-    let steps = (360.0 / SCAN_STEP_DEG).round() as usize;
+    let mut evaluations = 1;
     let mut best = (0.0, f(0.0));
-    for k in 0..steps {
-        let phi = -180.0 + k as f64 * SCAN_STEP_DEG;
-        let v = f(phi);
-        if v < best.1 {
-            best = (phi, v);
+    let mut counted = |phi: f64| {
+        evaluations += 1;
+        f(phi)
+    };
+    if let Some(found) = super::heading::refined_grid_minimum(&mut counted, SCAN_STEP_DEG) {
+        if found.1 < best.1 {
+            best = found;
         }
     }
-    let mut evaluations = steps + 1;
     let g = (5f64.sqrt() - 1.0) / 2.0;
     let (mut lo, mut hi) = (best.0 - SCAN_STEP_DEG, best.0 + SCAN_STEP_DEG);
     let mut x1 = hi - g * (hi - lo);
