@@ -14,9 +14,11 @@
 
 use super::auto::{Candidate, JointCandidates, CANDIDATES};
 use super::chain::{correct_chain, correct_deheaded_from};
-use super::{Cancelled, Correction, ImuHeading, RunControl};
+use super::cost::WindowCost;
+use super::window::layout;
+use super::{Cancelled, Correction, ImuHeading, RunControl, WindowSolution};
 use crate::limits::{LimitTable, Settings};
-use crate::model::Model;
+use crate::model::{Joint, Model};
 use crate::rotation::Quat;
 use crate::trial::Trial;
 use crate::variant::Variant;
@@ -170,7 +172,7 @@ fn compose(
         let run = runs.iter().find(|(v, _)| *v == choice.record.chosen);
         let mut result = match run {
             Some((_, c)) => c.joint(&joint.name).expect("corrected").clone(),
-            None => uncorrected_result(first, &joint.name),
+            None => uncorrected_result(trial, (joint, limits, settings), first),
         };
         if let Some((_, c)) = run.filter(|(v, _)| v.fits_headings()) {
             headings.extend(c.heading(&joint.distal).cloned());
@@ -202,20 +204,83 @@ fn compose(
     }
 }
 
-/// A joint's result when `none` was chosen: the first run's record with
-/// identity window corrections, no hinge and no baseline (the joint is as
-/// measured).
-fn uncorrected_result(first: &Correction, joint: &str) -> super::JointResult {
-    let mut r = first.joint(joint).expect("corrected").clone();
-    for w in &mut r.windows {
-        w.correction = [1.0, 0.0, 0.0, 0.0];
-        w.angle_deg = 0.0;
-        w.cost = w.cost_uncorrected;
-        w.evaluations = 0;
-    }
+/// A joint's result when `none` was chosen (the joint as measured): the
+/// first run's record without hinge or baseline, its windows' corrections
+/// the identity at the cost of the measured joint rotations
+/// `G_R_prox^-1 G_R_dist`, limits without the centroid term.
+fn uncorrected_result(
+    trial: &Trial,
+    (joint, limits, settings): (&Joint, &LimitTable, &Settings),
+    first: &Correction,
+) -> super::JointResult {
+    let mut r = first.joint(&joint.name).expect("corrected").clone();
+    let parent = &trial.imu(&joint.proximal).expect("present").orientation;
+    let child = &trial.imu(&joint.distal).expect("present").orientation;
+    let lim = limits.cost_limits(joint, false).expect("a corrected joint");
+    r.windows = layout(&trial.time_s, settings.window_s, settings.hop_s)
+        .iter()
+        .map(|w| {
+            let measured: Vec<Quat> = (w.first..w.end)
+                .map(|i| parent[i].inverse() * child[i])
+                .collect();
+            let cost = WindowCost::new(&measured, &lim, settings.lambda1).eval(&Quat::identity());
+            WindowSolution {
+                start_s: w.start_s,
+                end_s: w.end_s,
+                centre_s: w.centre_s,
+                samples: w.len(),
+                correction: [1.0, 0.0, 0.0, 0.0],
+                angle_deg: 0.0,
+                cost,
+                cost_uncorrected: cost,
+                evaluations: 1,
+            }
+        })
+        .collect();
     r.hinge = None;
     r.baseline = None;
     r.axis_from = None;
     r.lambda2 = 0.0;
     r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulate::{preset, simulate};
+
+    #[test]
+    fn a_joint_left_as_measured_records_the_measured_window_costs() {
+        let mut cfg = preset("full_body_clean").unwrap();
+        cfg.duration_s = 40.0;
+        let trial = simulate(&cfg).unwrap().trial;
+        let (model, table, settings) = (
+            Model::infant13(),
+            LimitTable::default_table(),
+            Settings::default(),
+        );
+        let drift = correct_chain(
+            &trial,
+            &model,
+            &table,
+            &settings,
+            Variant::Drift,
+            &RunControl::default(),
+        )
+        .unwrap();
+        // The back's proximal IMU is the base, which no run corrects: its
+        // measured windows are those `drift` solved, whose uncorrected
+        // cost is the same cost at the identity.
+        let back = model.joint("back").unwrap();
+        let none = uncorrected_result(&trial, (back, &table, &settings), &drift);
+        let solved = &drift.joint("back").unwrap().windows;
+        assert_eq!(none.windows.len(), solved.len());
+        assert!(solved.iter().any(|w| w.cost_uncorrected > 0.0));
+        for (n, s) in none.windows.iter().zip(solved) {
+            assert_eq!(n.correction, [1.0, 0.0, 0.0, 0.0]);
+            assert_eq!((n.start_s, n.samples), (s.start_s, s.samples));
+            let tol = 1e-12 * s.cost_uncorrected.abs().max(1.0);
+            assert!((n.cost - s.cost_uncorrected).abs() <= tol, "{n:?} {s:?}");
+        }
+    }
 }

@@ -59,10 +59,6 @@ pub fn correct_chain(
     if variant.headings_first() {
         return correct_deheaded(trial, model, limits, settings, variant, control);
     }
-    if variant == Variant::Auto {
-        let none = Default::default();
-        return super::auto_run::correct_auto(trial, model, limits, settings, &none, control);
-    }
     run(trial, model, limits, settings, variant, None, control)
 }
 
@@ -191,8 +187,7 @@ pub fn uncorrected(
 /// for the rest (after a limit edit, say). For the heading variants the joint
 /// above each named one is redone too, with everything below it: its IMU's fit
 /// looks ahead at the named joint's limits ([`super::lookahead`]); a variant
-/// that removes heading drift first is redone whole, and so is `auto` (its
-/// candidates' runs, keeping the user's overrides). `previous` must come
+/// that removes heading drift first is redone whole. `previous` must come
 /// from the same trial, model and variant, one of the chain's kinds.
 pub fn recorrect_chain(
     trial: &Trial,
@@ -206,12 +201,6 @@ pub fn recorrect_chain(
     if previous.variant.headings_first() {
         // The headings are fitted with every joint's limits: all is redone.
         return correct_chain(trial, model, limits, settings, previous.variant, control);
-    }
-    if previous.variant == Variant::Auto {
-        // Its candidates include the heading-first one: all is redone,
-        // keeping the user's overrides.
-        let forced = super::auto_run::overrides(previous);
-        return super::auto_run::correct_auto(trial, model, limits, settings, &forced, control);
     }
     let mut redo = BTreeSet::new();
     for (k, j) in model.joints.iter().enumerate() {

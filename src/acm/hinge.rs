@@ -702,7 +702,7 @@ pub fn minimise_about_axis(cost: &dyn Fn(&Quat, f64) -> f64, family: &AxisFamily
 /// The turn `phi` (degrees, in (-180, 180]) minimising `f` over the whole
 /// circle: the lowest point of the grid every [`SCAN_STEP_DEG`], looked for
 /// coarse to fine as the heading fit's scan is (every 3rd point, then the
-/// points around the coarse grid's three lowest local minima: 72
+/// points around the coarse grid's three lowest local minima: at most 72
 /// evaluations where the whole grid takes 180), `phi = 0` kept on a tie;
 /// then a golden-section search around it. Returns `(phi, f(phi),
 /// evaluations)`.
@@ -713,7 +713,7 @@ pub fn minimise_turn(f: &dyn Fn(f64) -> f64) -> (f64, f64, usize) {
         evaluations += 1;
         f(phi)
     };
-    if let Some(found) = super::heading::refined_grid_minimum(&mut counted, SCAN_STEP_DEG) {
+    if let Some(found) = super::circle_grid::refined_grid_minimum(&mut counted, SCAN_STEP_DEG) {
         if found.1 < best.1 {
             best = found;
         }

@@ -11,6 +11,7 @@
 pub mod auto;
 pub mod auto_run;
 pub mod chain;
+pub mod circle_grid;
 pub mod cost;
 pub mod heading;
 pub mod heading_cost;

@@ -24,8 +24,12 @@ pub fn correct_trial(
     match variant.kind() {
         Kind::Ik => correct_ik(trial, model, settings, control),
         Kind::None => Ok(acm::uncorrected(trial, model, limits, settings)),
-        Kind::Acm | Kind::Heading | Kind::Baseline | Kind::Auto => {
+        Kind::Acm | Kind::Heading | Kind::Baseline => {
             acm::correct_chain(trial, model, limits, settings, variant, control)
+        }
+        Kind::Auto => {
+            let none = Default::default();
+            acm::auto_run::correct_auto(trial, model, limits, settings, &none, control)
         }
     }
 }
@@ -46,8 +50,14 @@ pub fn recorrect(
         // Inverse kinematics and no correction do not read the limit table
         // or the settings.
         Kind::Ik | Kind::None => Ok(previous.clone()),
-        Kind::Acm | Kind::Heading | Kind::Baseline | Kind::Auto => {
+        Kind::Acm | Kind::Heading | Kind::Baseline => {
             acm::recorrect_chain(trial, model, limits, settings, previous, joints, control)
+        }
+        // Its candidates include a heading-first one: all is redone,
+        // keeping the user's overrides.
+        Kind::Auto => {
+            let forced = acm::auto_run::overrides(previous);
+            acm::auto_run::correct_auto(trial, model, limits, settings, &forced, control)
         }
     }
 }
